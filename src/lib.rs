@@ -1,0 +1,8 @@
+//! `restitution`: the coefficient of restitution of colliding spheres after Labous, Rosato & Dave,
+//! Phys. Rev. E 56, 5717 (1997). Physics modules are pure: no CLI, plotting or I/O.
+
+pub mod contact;
+pub mod error;
+pub mod models;
+
+pub use error::{Error, Result};

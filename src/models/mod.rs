@@ -1,0 +1,3 @@
+//! The physics: each equation of the paper lives in exactly one of these modules.
+
+pub mod viscoelastic;

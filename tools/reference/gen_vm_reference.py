@@ -1,0 +1,528 @@
+#!/usr/bin/env python3
+"""High-precision reference values for the viscoelastic (VM) master curve.
+
+Problem (PHYSICS.md section 2, dimensionless):
+
+    x'' = -x^(3/2) - kappa x^(1/2) x',   x(0) = 0,  x'(0) = 1,   p = x'.
+
+Two end-of-contact rules:
+  overlap: first t > 0 with x = 0;                       e = -p(t_end)
+  force:   first t > 0 with x + kappa p = 0 (x > 0, p < 0); e = -p(t_end)
+
+Formulation (independent of the Rust code; analytic everywhere)
+----------------------------------------------------------------
+The right-hand side contains x^(1/2), so x(t) is not analytic at t = 0
+(x = t - (4/15) kappa t^(5/2) + ...) nor at the overlap end (x -> 0 with p != 0).
+With r = sqrt(x) and a new independent variable sigma defined by
+
+    dt = r dsigma          (sigma = 2 sqrt(t) + ... near t = 0)
+
+the system becomes *polynomial*:
+
+    dr/dsigma = p/2
+    dp/dsigma = -r^4 - kappa r^2 p
+    dt/dsigma = r
+    dD/dsigma = kappa r^2 p^2        (D = dissipated energy, dD/dt = kappa x^(1/2) p^2)
+
+with r(0) = 0, p(0) = 1, t(0) = 0, D(0) = 0.  Its solution is analytic in sigma
+through t = 0, through the turning point (p = 0) and through the overlap end,
+where r crosses zero linearly (dr/dsigma = p/2 != 0).  x = r^2 >= 0 on both sides
+of sigma = 0, and dt/dsigma = r > 0 during the contact, so sigma is monotone in t.
+The sigma-form is also not stiff at large kappa: the fast rate in sigma is
+kappa r^2 = kappa x, which is O(kappa^(1/3)) at the maximum overlap
+x_max ~ (3/(2 kappa))^(2/3) and decreases afterwards.
+
+The system is integrated with an arbitrary-order Taylor method (coefficients by
+the usual Cauchy-product recurrences, in mpmath at working precision dps) with a
+step size chosen so that the last two Taylor terms are below 10^-(dps+4) of the
+size of each component over the step (a relative criterion per component, so
+the tiny r and p at the end of a large-kappa contact keep their relative
+accuracy).  Events are found by sign changes of the event function on the step's
+Taylor polynomial, then located by mpmath.findroot (Anderson/Illinois bracket,
+then Newton polish) on that polynomial, i.e. to full working precision:
+
+    p = 0                       -> x_max = r^2
+    d/dsigma(r^3 + kappa r p)=0 -> local maxima of the force F = x^(3/2) + kappa x^(1/2) p
+    r^2 + kappa p = 0 (+ to -)  -> force-rule end
+    r = 0 (+ to -)              -> overlap-rule end
+
+e = -p(end).  For relative accuracy of 1 - e the energy balance is used:
+    overlap: e^2 = 1 - 2D
+    force:   e^2 = 1 - 2D - (4/5) x_end^(5/2)
+    1 - e = (1 - e^2)/(1 + e)
+(when e < 1/2, 1 - e = 1 + p(end) has no cancellation and is used instead); the
+two forms are asserted to agree.
+
+Cross-checks (asserted and printed):
+  (a) every output quantity at dps = 30 and dps = 45 agrees (e to < 1e-22
+      absolute and relative, 1 - e to < 1e-22 relative, others < 1e-22 relative);
+  (b) kappa = 0: tau_contact against the closed form
+      tau = 2 (5/4)^(2/5) (2/5) B(2/5, 1/2)  (= 2 (5/4)^(2/5) int_0^1 du/sqrt(1-u^(5/2)),
+      also evaluated by mpmath.quad) and the literature value 3.2180654597190430845;
+      x_max(0) = (5/4)^(2/5);
+  (c) small kappa (overlap rule): (1-e)/kappa -> C1 with
+      C1 = 2 (5/4)^(3/5) (2/5) B(3/5, 3/2) = 1.15344885809528879913...
+      (first-order perturbation: C1 = int_Hertz x^(1/2) p^2 dt), and
+      ((1-e) - C1 kappa)/kappa^2 -> -C2, C2 = (3/5) C1^2;
+  (d) force rule at small kappa: reported (half-integer powers; leading correction
+      e_force - e_overlap ~ (4/15) kappa^(5/2), derived in the README).
+
+Writes tests/fixtures/vm_reference.csv and tests/fixtures/vm_series.csv
+(relative to the repository root).  Usage:  python3 tools/reference/gen_vm_reference.py
+"""
+
+import math
+import os
+import sys
+import time
+
+import mpmath
+from mpmath import mp, mpf
+
+KAPPAS = ["1e-8", "1e-6", "1e-4", "1e-3", "3e-3", "0.01", "0.02", "0.05", "0.1", "0.2",
+          "0.3", "0.5", "0.7", "1", "1.5", "2", "3", "5", "7", "10", "20", "50", "100"]
+
+DPS_LO = 30
+DPS_HI = 45
+OUT_DIGITS = 25          # significant digits written to the CSV
+HERTZ_TAU_LIT = "3.2180654597190430845"
+C1_LIT = "1.15344885809528879913"
+
+REPO = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+FIXTURES = os.path.join(REPO, "tests", "fixtures")
+
+
+# --------------------------------------------------------------------------------------
+# Taylor integrator for the sigma-system
+# --------------------------------------------------------------------------------------
+
+def taylor_coeffs(r0, p0, t0, D0, kappa, N):
+    """Taylor coefficients (orders 0..N) of r, p, t, D about the current point."""
+    fsum = mp.fsum
+    R = [r0]; P = [p0]; T = [t0]; DD = [D0]
+    A = []   # r^2
+    B = []   # r^4
+    C = []   # r^2 p
+    G = []   # r^2 p^2
+    for n in range(N):
+        A.append(fsum(R[k] * R[n - k] for k in range(n + 1)))
+        B.append(fsum(A[k] * A[n - k] for k in range(n + 1)))
+        C.append(fsum(A[k] * P[n - k] for k in range(n + 1)))
+        G.append(fsum(C[k] * P[n - k] for k in range(n + 1)))
+        m = n + 1
+        R.append(P[n] / (2 * m))
+        P.append(-(B[n] + kappa * C[n]) / m)
+        T.append(R[n] / m)
+        DD.append(kappa * G[n] / m)
+    return R, P, T, DD
+
+
+def _logabs(c):
+    if c == 0:
+        return -math.inf
+    return float(mpmath.log(abs(c)))
+
+
+def choose_step(series_list, N, log_eps):
+    """Largest h with (each of the last 6 Taylor terms) <= eps * (size of the component
+    over [0, h]) for all components.  Works on log-magnitudes (floats), bisection in
+    log h."""
+    comps = []
+    for S in series_list:
+        lm = [_logabs(c) for c in S]
+        if all(v == -math.inf for v in lm[1:]):
+            continue            # constant component (e.g. D when kappa = 0)
+        comps.append(lm)
+
+    def ok(lh):
+        for lm in comps:
+            scale = max(lm[k] + k * lh for k in range(len(lm)) if lm[k] > -math.inf)
+            tail = max(lm[k] + k * lh for k in TAIL)
+            if tail - scale > log_eps:
+                return False
+        return True
+
+    # the last 6 orders: the series at sigma = 0 has gaps of period 5 when kappa = 0
+    TAIL = range(N - 5, N + 1)
+    lo, hi = -60.0, 60.0
+    if not ok(lo):
+        raise RuntimeError("step size underflow")
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        if ok(mid):
+            lo = mid
+        else:
+            hi = mid
+    return mpmath.exp(mpf(lo))
+
+
+def horner(S, s):
+    acc = mpf(0)
+    for c in reversed(S):
+        acc = acc * s + c
+    return acc
+
+
+def dhorner(S, s):
+    acc = mpf(0)
+    n = len(S) - 1
+    for k in range(n, 0, -1):
+        acc = acc * s + k * S[k]
+    return acc
+
+
+def refine_root(f, a, b):
+    """Root of f in [a, b] (f(a) > 0 >= f(b)), to full working precision."""
+    fa, fb = f(a), f(b)
+    if fb == 0:
+        return b
+    x = mp.findroot(f, (a, b), solver="anderson", tol=mpf(2) ** (-2 * mp.prec))
+    # Newton-free polish by a few secant/bisection steps inside the bracket
+    if not (a <= x <= b):
+        # fall back to pure bisection
+        lo, hi = a, b
+        for _ in range(mp.prec + 10):
+            mid = (lo + hi) / 2
+            if f(mid) > 0:
+                lo = mid
+            else:
+                hi = mid
+        x = (lo + hi) / 2
+    return x
+
+
+class Result:
+    pass
+
+
+def integrate(kappa, dps, want_force=True, max_steps=200000, verbose=False):
+    """Integrate one contact.  Returns a Result with both rules' quantities."""
+    with mp.workdps(dps):
+        kappa = mpf(kappa)
+        N = int(math.ceil(1.15 * (dps + 4))) + 4
+        log_eps = -(dps + 4) * math.log(10.0)
+        sig = mpf(0)
+        r, p, t, D = mpf(0), mpf(1), mpf(0), mpf(0)
+
+        res = Result()
+        res.kappa = kappa
+        res.x_max = None
+        res.force_maxima = []      # list of (F, sigma)
+        res.force_end = None
+        res.overlap_end = None
+        steps = 0
+
+        def F_of(rv, pv):
+            return rv ** 3 + kappa * rv * pv
+
+        def dF_of(rv, pv):
+            # dF/dsigma with dr/dsigma = p/2, dp/dsigma = -r^4 - kappa r^2 p
+            return mpf(3) / 2 * rv ** 2 * pv + kappa * (pv ** 2 / 2 + rv * (-rv ** 4 - kappa * rv ** 2 * pv))
+
+        while True:
+            steps += 1
+            if steps > max_steps:
+                raise RuntimeError("too many steps (kappa=%s)" % kappa)
+            R, P, T, DD = taylor_coeffs(r, p, t, D, kappa, N)
+            h = choose_step([R, P, T, DD], N, log_eps)
+
+            rs = lambda s: horner(R, s)
+            ps = lambda s: horner(P, s)
+            events = {}
+            if res.x_max is None:
+                events["pzero"] = ps
+            if want_force and res.force_end is None and kappa > 0:
+                # r|r| instead of r^2: stays negative past the overlap end (r < 0), so a
+                # force end and an overlap end inside one grid cell are both seen
+                events["fend"] = lambda s: rs(s) * abs(rs(s)) + kappa * ps(s)
+            if res.force_end is None or res.overlap_end is None:
+                events["dF"] = lambda s: dF_of(rs(s), ps(s))
+            events["oend"] = rs
+
+            M = 16
+            grid = [h * j / M for j in range(M + 1)]
+            found = {}
+            for name, f in events.items():
+                vals = [f(s) for s in grid]
+                for j in range(M):
+                    if vals[j] > 0 and vals[j + 1] <= 0:
+                        found[name] = refine_root(f, grid[j], grid[j + 1])
+                        break
+            # also a sign change of dF from + to - that is a local max: handled by 'dF'
+            if "pzero" in found:
+                s = found["pzero"]
+                res.x_max = rs(s) ** 2
+                res.sig_xmax = sig + s
+            if "dF" in found:
+                s = found["dF"]
+                res.force_maxima.append((F_of(rs(s), ps(s)), sig + s))
+            if "fend" in found:
+                s = found["fend"]
+                rr, pp = rs(s), ps(s)
+                res.force_end = dict(sigma=sig + s, r=rr, p=pp, t=horner(T, s), D=horner(DD, s))
+            if "oend" in found:
+                s = found["oend"]
+                rr, pp = rs(s), ps(s)
+                res.overlap_end = dict(sigma=sig + s, r=rr, p=pp, t=horner(T, s), D=horner(DD, s))
+                break
+            r, p, t, D = rs(h), ps(h), horner(T, h), horner(DD, h)
+            sig += h
+        if want_force and kappa > 0:
+            assert res.force_end is not None and res.force_end["sigma"] < res.overlap_end["sigma"]
+            assert res.force_end["r"] > 0 and res.force_end["p"] < 0
+        res.steps = steps
+        res.N = N
+
+        # derived quantities
+        out = {}
+        for rule, ev in (("overlap", res.overlap_end), ("force", res.force_end)):
+            if ev is None:
+                continue
+            e = -ev["p"]
+            x_end = ev["r"] ** 2
+            if rule == "overlap":
+                one_m_e2 = 2 * ev["D"]
+            else:
+                one_m_e2 = 2 * ev["D"] + mpf(4) / 5 * x_end ** mpf(2.5)
+            e_energy = mpmath.sqrt(1 - one_m_e2)
+            ome_energy = one_m_e2 / (1 + e)
+            ome_direct = 1 + ev["p"]
+            ome = ome_energy if e > 0.5 else ome_direct
+            # consistency of the two formulations (energy balance vs trajectory)
+            assert abs(ome_energy - ome_direct) <= mpf(10) ** (-(dps - 8)), \
+                (rule, kappa, ome_energy, ome_direct)
+            # force maximum over the contact (force is positive only before the force end)
+            tend_sig = ev["sigma"]
+            Fs = [F for (F, s) in res.force_maxima if s <= tend_sig]
+            Fmax = max(Fs) if Fs else mpf(0)
+            out[rule] = dict(e=e, one_minus_e=ome, tau=ev["t"], x_max=res.x_max, force_max=Fmax,
+                             e_energy=e_energy, ome_direct=ome_direct, ome_energy=ome_energy,
+                             x_end=x_end)
+        res.out = out
+        return res
+
+
+# --------------------------------------------------------------------------------------
+# Closed forms
+# --------------------------------------------------------------------------------------
+
+def hertz_tau_closed():
+    return 2 * (mpf(5) / 4) ** (mpf(2) / 5) * (mpf(2) / 5) * mpmath.beta(mpf(2) / 5, mpf(1) / 2)
+
+
+def hertz_tau_quad():
+    # int_0^1 du / sqrt(1 - u^(5/2)); integrable singularity at u = 1, tanh-sinh handles it
+    # on [1/2, 1] substitute u = 1 - w^2 (removes the 1/sqrt singularity at u = 1) and
+    # write 1 - u^(5/2) = -expm1((5/2) log1p(-w^2)) to keep full relative accuracy
+    I1 = mp.quad(lambda u: 1 / mpmath.sqrt(1 - u ** mpf(2.5)), [0, mpf(1) / 2])
+    I2 = mp.quad(lambda w: 2 * w / mpmath.sqrt(-mpmath.expm1(mpf(2.5) * mpmath.log1p(-w * w))),
+                 [0, 1 / mpmath.sqrt(2)])
+    I = I1 + I2
+    return 2 * (mpf(5) / 4) ** (mpf(2) / 5) * I
+
+
+def c1_closed():
+    # C1 = int_0^tau x^(1/2) p^2 dt (Hertz) = 2 int_0^xm x^(1/2) sqrt(1 - (4/5) x^(5/2)) dx
+    #    = 2 xm^(3/2) (2/5) B(3/5, 3/2),  xm = (5/4)^(2/5)
+    return 2 * (mpf(5) / 4) ** (mpf(3) / 5) * (mpf(2) / 5) * mpmath.beta(mpf(3) / 5, mpf(3) / 2)
+
+
+def fmt(v, digits=OUT_DIGITS):
+    return mpmath.nstr(v, digits, min_fixed=-5, max_fixed=8, strip_zeros=False).replace("E", "e")
+
+
+def rel(a, b):
+    if a == b:
+        return mpf(0)
+    return abs(a - b) / max(abs(a), abs(b))
+
+
+def main():
+    t_start = time.time()
+    os.makedirs(FIXTURES, exist_ok=True)
+    failures = []
+
+    def check(cond, msg):
+        print(("  PASS  " if cond else "  FAIL  ") + msg)
+        if not cond:
+            failures.append(msg)
+
+    mp.dps = DPS_HI + 10
+    print("== Closed forms (dps %d) ==" % mp.dps)
+    tau_beta = hertz_tau_closed()
+    tau_quad = hertz_tau_quad()
+    c1 = c1_closed()
+    c2 = mpf(3) / 5 * c1 ** 2
+    xm0 = (mpf(5) / 4) ** (mpf(2) / 5)
+    print("  hertz tau (Beta form) = %s" % mpmath.nstr(tau_beta, 40))
+    print("  hertz tau (quad)      = %s" % mpmath.nstr(tau_quad, 40))
+    print("  x_max(0) = (5/4)^(2/5) = %s" % mpmath.nstr(xm0, 40))
+    print("  C1 = 2 (5/4)^(3/5) (2/5) B(3/5,3/2) = %s" % mpmath.nstr(c1, 40))
+    print("  C2 = (3/5) C1^2 = %s" % mpmath.nstr(c2, 40))
+    check(rel(tau_beta, tau_quad) < mpf(10) ** -40, "tau(0): Beta form == quadrature (rel %s)"
+          % mpmath.nstr(rel(tau_beta, tau_quad), 3))
+    check(rel(tau_beta, mpf(HERTZ_TAU_LIT)) < mpf(10) ** -19, "tau(0) == 3.2180654597190430845 (rel %s)"
+          % mpmath.nstr(rel(tau_beta, mpf(HERTZ_TAU_LIT)), 3))
+    check(rel(c1, mpf(C1_LIT)) < mpf(10) ** -19, "C1 closed form == 1.15344885809528879913 (rel %s)"
+          % mpmath.nstr(rel(c1, mpf(C1_LIT)), 3))
+
+    print("== kappa = 0 (Hertz) by the ODE integrator, dps %d ==" % DPS_HI)
+    r0 = integrate(0, DPS_HI, want_force=False)
+    o0 = r0.out["overlap"]
+    print("  tau = %s  (steps %d)" % (mpmath.nstr(o0["tau"], 40), r0.steps))
+    print("  x_max = %s  e = %s" % (mpmath.nstr(o0["x_max"], 40), mpmath.nstr(o0["e"], 40)))
+    check(rel(o0["tau"], tau_beta) < mpf(10) ** -(DPS_HI - 5), "ODE tau(0) == Beta form (rel %s)"
+          % mpmath.nstr(rel(o0["tau"], tau_beta), 3))
+    check(rel(o0["x_max"], xm0) < mpf(10) ** -(DPS_HI - 5), "ODE x_max(0) == (5/4)^(2/5) (rel %s)"
+          % mpmath.nstr(rel(o0["x_max"], xm0), 3))
+    check(abs(o0["one_minus_e"]) < mpf(10) ** -(DPS_HI - 5), "ODE e(0) == 1 (|1-e| = %s)"
+          % mpmath.nstr(abs(o0["one_minus_e"]), 3))
+    check(rel(o0["force_max"], xm0 ** mpf(1.5)) < mpf(10) ** -(DPS_HI - 5),
+          "ODE force_max(0) == x_max^(3/2)")
+
+    print("== Main table: dps %d vs dps %d ==" % (DPS_LO, DPS_HI))
+    results = {}
+    worst = {}
+    for ks in KAPPAS:
+        t0 = time.time()
+        lo = integrate(mpf(ks), DPS_LO)
+        t1 = time.time()
+        hi = integrate(mpf(ks), DPS_HI)
+        t2 = time.time()
+        results[ks] = hi
+        with mp.workdps(DPS_HI):
+            for rule in ("overlap", "force"):
+                a, b = lo.out[rule], hi.out[rule]
+                d_e = abs(a["e"] - b["e"])
+                r_e = rel(a["e"], b["e"])
+                r_ome = rel(a["one_minus_e"], b["one_minus_e"])
+                r_tau = rel(a["tau"], b["tau"])
+                r_x = rel(a["x_max"], b["x_max"])
+                r_f = rel(a["force_max"], b["force_max"])
+                m = max(d_e, r_e, r_ome, r_tau, r_x, r_f)
+                worst[(ks, rule)] = m
+                ok = m < mpf(10) ** -22
+                if not ok:
+                    failures.append("precision check kappa=%s rule=%s: %s" % (ks, rule, mpmath.nstr(m, 3)))
+                print("  kappa=%-6s %-7s e=%s 1-e=%s tau=%s  max diff(dps%d,dps%d)=%s %s"
+                      % (ks, rule, mpmath.nstr(b["e"], 22), mpmath.nstr(b["one_minus_e"], 12),
+                         mpmath.nstr(b["tau"], 12), DPS_LO, DPS_HI, mpmath.nstr(m, 2),
+                         "ok" if ok else "FAIL"))
+        print("      steps %d/%d (N=%d/%d), %.1fs + %.1fs" % (lo.steps, hi.steps, lo.N, hi.N, t1 - t0, t2 - t1))
+        sys.stdout.flush()
+
+    with mp.workdps(DPS_HI):
+        overall = max(worst.values())
+        check(overall < mpf(10) ** -22, "(a) all quantities, dps %d vs %d: worst difference %s (< 1e-22)"
+              % (DPS_LO, DPS_HI, mpmath.nstr(overall, 3)))
+
+        print("== Small-kappa behaviour, overlap rule ==")
+        for ks in ["1e-8", "1e-6", "1e-4", "1e-3", "3e-3", "0.01"]:
+            k = mpf(ks)
+            ome = results[ks].out["overlap"]["one_minus_e"]
+            a1 = ome / k
+            a2 = (ome - c1 * k) / k ** 2
+            print("  kappa=%-5s (1-e)/kappa = %s   ((1-e)-C1 kappa)/kappa^2 = %s   (+C2 = %s)"
+                  % (ks, mpmath.nstr(a1, 25), mpmath.nstr(a2, 20), mpmath.nstr(a2 + c2, 6)))
+        k8 = mpf("1e-8")
+        a1_8 = results["1e-8"].out["overlap"]["one_minus_e"] / k8
+        check(rel(a1_8, c1) < 2e-7, "(1-e)/kappa at kappa=1e-8 vs C1: rel %s (~C2/C1*1e-8 = %s)"
+              % (mpmath.nstr(rel(a1_8, c1), 4), mpmath.nstr(c2 / c1 * k8, 4)))
+        a2s = {}
+        for ks in ["1e-8", "1e-6", "1e-4", "1e-3"]:
+            k = mpf(ks)
+            a2s[ks] = (results[ks].out["overlap"]["one_minus_e"] - c1 * k) / k ** 2
+        # trend: the deviation from -C2 must shrink roughly in proportion to kappa
+        d3 = abs(a2s["1e-3"] + c2)
+        d4 = abs(a2s["1e-4"] + c2)
+        d6 = abs(a2s["1e-6"] + c2)
+        check(d4 < d3 / 5 and d3 < mpf("0.05") * c2, "((1-e)-C1 k)/k^2 -> -C2: |dev| %s at 1e-3, %s at 1e-4"
+              % (mpmath.nstr(d3, 4), mpmath.nstr(d4, 4)))
+        check(d6 < mpf("1e-4") * c2, "((1-e)-C1 k)/k^2 at kappa=1e-6 equals -C2 to rel %s"
+              % mpmath.nstr(d6 / c2, 4))
+        # third-order estimate
+        c3_est = {}
+        for ks in ["1e-8", "1e-6", "1e-4", "1e-3"]:
+            k = mpf(ks)
+            c3_est[ks] = (a2s[ks] + c2) / k
+            print("  kappa=%-5s ((1-e) - C1 k + C2 k^2)/k^3 = %s" % (ks, mpmath.nstr(c3_est[ks], 12)))
+
+        print("== Small-kappa behaviour, force rule ==")
+        force_rows = []
+        for ks in ["1e-8", "1e-6", "1e-4", "1e-3", "3e-3", "0.01", "0.02", "0.05"]:
+            k = mpf(ks)
+            of = results[ks].out["force"]
+            oo = results[ks].out["overlap"]
+            de = of["e"] - oo["e"]
+            b52 = (of["one_minus_e"] - c1 * k + c2 * k ** 2) / k ** mpf(2.5)
+            print("  kappa=%-5s (1-e_f)/kappa = %s  (e_f - e_o)/kappa^(5/2) = %s  "
+                  "((1-e_f)-C1 k+C2 k^2)/k^(5/2) = %s  x_end/kappa = %s"
+                  % (ks, mpmath.nstr(of["one_minus_e"] / k, 20), mpmath.nstr(de / k ** mpf(2.5), 15),
+                     mpmath.nstr(b52, 15), mpmath.nstr(of["x_end"] / k, 15)))
+            force_rows.append((ks, de / k ** mpf(2.5), b52))
+        for ks in ["1e-8", "1e-6", "1e-4"]:
+            k = mpf(ks)
+            de = results[ks].out["force"]["e"] - results[ks].out["overlap"]["e"]
+            print("  kappa=%-5s ((e_f - e_o) - (4/15) kappa^(5/2))/kappa^(7/2) = %s"
+                  % (ks, mpmath.nstr((de - mpf(4) / 15 * k ** mpf(2.5)) / k ** mpf(3.5), 12)))
+        k8 = mpf("1e-8")
+        d72_est = ((results["1e-8"].out["force"]["e"] - results["1e-8"].out["overlap"]["e"])
+                   - mpf(4) / 15 * k8 ** mpf(2.5)) / k8 ** mpf(3.5)
+        check(abs(force_rows[0][1] - mpf(4) / 15) < 1e-3,
+              "force rule: (e_f - e_o)/kappa^(5/2) -> 4/15 (at kappa=1e-8: %s)" % mpmath.nstr(force_rows[0][1], 12))
+
+        print("== Large-kappa behaviour ==")
+        # Overlap rule: x = kappa^-4 X, t = kappa T maps the late (slow-manifold) phase onto
+        # the parameter-free X'' = -X^(3/2) - X^(1/2) X', so e kappa^5 -> A with corrections
+        # that are exponentially small in kappa (the fast mode contracts by ~exp(-2 kappa^2 x_max^(1/2))).
+        a_large = results["100"].out["overlap"]["e"] * mpf(100) ** 5
+        for ks in ["3", "5", "7", "10", "20", "50", "100"]:
+            k = mpf(ks)
+            oo = results[ks].out["overlap"]
+            of = results[ks].out["force"]
+            print("  kappa=%-4s overlap: e=%s e*kappa^5=%s (rel dev from kappa=100: %s) tau=%s | "
+                  "force: e=%s e*kappa^(5/3)=%s tau=%s"
+                  % (ks, mpmath.nstr(oo["e"], 10), mpmath.nstr(oo["e"] * k ** 5, 22),
+                     mpmath.nstr(rel(oo["e"] * k ** 5, a_large), 3), mpmath.nstr(oo["tau"], 8),
+                     mpmath.nstr(of["e"], 10), mpmath.nstr(of["e"] * k ** (mpf(5) / 3), 8),
+                     mpmath.nstr(of["tau"], 8)))
+
+        # ---- write CSVs ----
+        path = os.path.join(FIXTURES, "vm_reference.csv")
+        with open(path, "w") as f:
+            f.write("rule,kappa,e,one_minus_e,tau_contact,x_max,force_max\n")
+            for rule in ("overlap", "force"):
+                for ks in KAPPAS:
+                    o = results[ks].out[rule]
+                    f.write(",".join([rule, ks, fmt(o["e"]), fmt(o["one_minus_e"]), fmt(o["tau"]),
+                                      fmt(o["x_max"]), fmt(o["force_max"])]) + "\n")
+        print("wrote %s" % os.path.relpath(path, REPO))
+
+        # small-kappa series constants
+        path = os.path.join(FIXTURES, "vm_series.csv")
+        with open(path, "w") as f:
+            f.write("name,value\n")
+            f.write("hertz_tau,%s\n" % fmt(tau_beta, 30))
+            f.write("hertz_x_max,%s\n" % fmt(xm0, 30))
+            f.write("hertz_force_max,%s\n" % fmt(xm0 ** mpf(1.5), 30))
+            f.write("c1,%s\n" % fmt(c1, 30))
+            f.write("c2,%s\n" % fmt(c2, 30))
+            f.write("c3_estimate,%s\n" % fmt(c3_est["1e-8"], 9))
+            f.write("force_rule_c72_estimate,%s\n" % fmt(d72_est, 9))
+            f.write("overlap_large_kappa_a,%s\n" % fmt(a_large, 20))
+            f.write("force_rule_c52,%s\n" % fmt(mpf(4) / 15, 30))
+            f.write("start_series_t52_over_kappa,%s\n" % fmt(mpf(-4) / 15, 30))
+            f.write("start_series_t72,%s\n" % fmt(mpf(-4) / 35, 30))
+        print("wrote %s" % os.path.relpath(path, REPO))
+
+    print("total runtime %.1f s" % (time.time() - t_start))
+    if failures:
+        print("FAILED CHECKS:")
+        for m in failures:
+            print("  " + m)
+        sys.exit(1)
+    print("all checks passed")
+
+
+if __name__ == "__main__":
+    main()
