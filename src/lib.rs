@@ -2,6 +2,7 @@
 //! Phys. Rev. E 56, 5717 (1997). Physics modules are pure: no CLI, plotting or I/O.
 
 pub mod contact;
+pub mod data;
 pub mod error;
 pub mod models;
 

@@ -1,1 +1,53 @@
-fn main() {}
+//! The `restitution` binary: a thin front end over the library (see `src/cli/`).
+
+mod cli;
+
+use clap::error::ErrorKind;
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Coefficient of restitution of colliding spheres (Labous, Rosato & Dave, PRE 56, 5717, 1997).
+#[derive(Parser)]
+#[command(name = "restitution", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// e(v) from the viscoelastic or plastic model
+    Predict(cli::predict::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            return match e.kind() {
+                ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => {
+                    let _ = e.print();
+                    ExitCode::SUCCESS
+                }
+                _ => {
+                    // One line: clap's first line names the flag and the value.
+                    let text = e.render().to_string();
+                    let first = text.lines().next().unwrap_or("invalid arguments");
+                    let first = first.strip_prefix("error: ").unwrap_or(first);
+                    eprintln!("restitution: error: {first} (see --help)");
+                    ExitCode::from(2)
+                }
+            };
+        }
+    };
+    let result = match cli.command {
+        Command::Predict(args) => cli::predict::run(args),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(msg) => {
+            eprintln!("restitution: error: {msg}");
+            ExitCode::FAILURE
+        }
+    }
+}

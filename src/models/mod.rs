@@ -1,3 +1,4 @@
 //! The physics: each equation of the paper lives in exactly one of these modules.
 
+pub mod plastic;
 pub mod viscoelastic;

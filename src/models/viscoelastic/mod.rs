@@ -38,6 +38,9 @@ use ode_solvers::{Dop853, Dopri5, OutputType, System};
 use std::fmt;
 use std::str::FromStr;
 
+pub mod master;
+mod master_table;
+
 // The fourth component carries the independent variable, so that the system is autonomous:
 // ode_solvers 0.6's Dop853 tableau has c_12 = 0 where DOP853 needs c_12 = 1, which silently
 // degrades it to first order on non-autonomous systems (found here: with r explicit in the right
@@ -536,6 +539,25 @@ fn locate(
 
 /// e and the other collision figures for dimensionless damping `kappa` (PHYSICS.md §2).
 pub fn rebound(kappa: f64, rule: ContactEnd, settings: &OdeSettings) -> Result<Rebound> {
+    solve(kappa, rule, settings, true)
+}
+
+/// e alone by the ODE: as [`rebound`] but without locating the overlap and force maxima
+/// (about half the right-hand-side evaluations).
+pub fn restitution_ode(
+    kappa: f64,
+    rule: ContactEnd,
+    settings: &OdeSettings,
+) -> Result<Restitution> {
+    let r = solve(kappa, rule, settings, false)?;
+    Ok(Restitution {
+        e: r.e,
+        one_minus_e: r.one_minus_e,
+        rhs_evals: r.rhs_evals,
+    })
+}
+
+fn solve(kappa: f64, rule: ContactEnd, settings: &OdeSettings, extrema: bool) -> Result<Rebound> {
     non_negative("dimensionless damping kappa", kappa)?;
     let mut evals = 0u64;
     let mut steps = 0u64;
@@ -545,12 +567,14 @@ pub fn rebound(kappa: f64, rule: ContactEnd, settings: &OdeSettings) -> Result<R
 
     let mut note_events = |phase: &Phase, evals: &mut u64| -> Result<Option<(f64, State)>> {
         let var = phase.stage.var();
-        if let Some(b) = &phase.brackets[Event::Turning as usize] {
+        if !extrema {
+            // Only the force-rule end below.
+        } else if let Some(b) = &phase.brackets[Event::Turning as usize] {
             let (s, y, n) = locate(kappa, var, Event::Turning, b, settings)?;
             *evals += n;
             x_max = x_p(var, s, &y).0;
         }
-        if let Some(b) = &phase.brackets[Event::ForceMax as usize] {
+        if let (true, Some(b)) = (extrema, &phase.brackets[Event::ForceMax as usize]) {
             let (s, y, n) = locate(kappa, var, Event::ForceMax, b, settings)?;
             *evals += n;
             let (x, p) = x_p(var, s, &y);
@@ -659,6 +683,43 @@ pub fn rebound(kappa: f64, rule: ContactEnd, settings: &OdeSettings) -> Result<R
         rhs_evals: evals,
         steps,
     })
+}
+
+/// e and 1 - e from any of the evaluation methods, with the work it took.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Restitution {
+    pub e: f64,
+    /// 1 - e with its own relative accuracy.
+    pub one_minus_e: f64,
+    /// Right-hand-side evaluations (0 for closed forms and tables).
+    pub rhs_evals: u64,
+}
+
+/// How e(kappa) is evaluated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum VmMethod {
+    /// The master-curve table inside its range, the default ODE outside it.
+    Master,
+    /// The ODE at the given setting, for every point.
+    Ode(OdeSettings),
+}
+
+impl Default for VmMethod {
+    fn default() -> Self {
+        VmMethod::Master
+    }
+}
+
+/// e(kappa) by the chosen method (the master curve falls back to the default ODE above
+/// [`master::KAPPA_MAX`]).
+pub fn restitution(kappa: f64, rule: ContactEnd, method: &VmMethod) -> Result<Restitution> {
+    match method {
+        VmMethod::Master => match master::restitution_master(kappa, rule) {
+            Some(r) => Ok(r),
+            None => restitution_ode(kappa, rule, &OdeSettings::DEFAULT),
+        },
+        VmMethod::Ode(settings) => restitution_ode(kappa, rule, settings),
+    }
 }
 
 /// A viscoelastic contact with damping eta (kg s^-1 m^-1), in SI units.

@@ -1,0 +1,182 @@
+//! Plastic model (PM): Eqs. (12)-(18) and Appendix B of Labous et al. (1997), PHYSICS.md §3.
+//!
+//! **Solves** the work balance of a Hertz loading up to yield, a linear (perfectly plastic) loading
+//! branch of slope pi sigma_y R~ (Eq. 12), and a Hertzian unloading of larger curvature fixed by
+//! continuity of P* and a* (Eq. 14), whose rebound work is W_r = 3 P*^2/(10 E* a*) (Eq. 17).
+//!
+//! **Closed form** (PHYSICS.md §3), with u = V/V_Y:
+//! e = 1 for u <= 1; e = (1 + 1.5 q)/(u (1 + q)^(1/4)), q = 4 (u^2 - 1)/(sqrt(30 u^2 - 5) + 5).
+//! The curve is universal: no size or material dependence once V_Y is known (Eq. 15).
+//!
+//! **Accuracy near u = 1.** 1 - e vanishes like (u - 1)^2 there, so 1 - e computed as 1 - e loses
+//! all its digits. With w = sqrt(30 u^2 - 5) (q = (2/15)(w - 5)) the closed form becomes
+//! e^4 = 21.6 w^4 / ((w^2 + 5)^2 (2w + 5)), and
+//! 1 - e^4 = (w - 5)^2 (2w^3 + 3.4w^2 + 4w + 5) / ((w^2 + 5)^2 (2w + 5)),
+//! with w - 5 = 30 (u - 1)(u + 1)/(w + 5) free of cancellation (derived here, checked against
+//! mpmath at 50 digits in `tests/fixtures/pm_reference.csv`). Relative accuracy of 1 - e is then
+//! a few ulp from u = 1 + 1e-12 to u = 1e12 (tests/plastic.rs).
+
+use crate::contact::Contact;
+use crate::error::{Error, Result, positive};
+
+/// The large-u asymptote e ~ C u^(-1/4): C = (sqrt 30 / 5)(2 sqrt 30 / 15)^(-1/4) = 1.18499...
+/// (the paper's 1.18, Eq. 18).
+pub fn asymptote_c() -> f64 {
+    let s30 = 30f64.sqrt();
+    s30 / 5.0 * (2.0 * s30 / 15.0).powf(-0.25)
+}
+
+/// e and 1 - e of the plastic model, each with its own relative accuracy.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlasticRebound {
+    pub e: f64,
+    pub one_minus_e: f64,
+}
+
+/// w = sqrt(30 u^2 - 5), without overflow for huge u.
+fn w_of(u: f64) -> f64 {
+    if u < 1e100 {
+        (30.0 * u * u - 5.0).sqrt()
+    } else {
+        u * 30f64.sqrt()
+    }
+}
+
+/// e(u) and 1 - e(u) for u = V/V_Y >= 0 (PHYSICS.md §3 closed form).
+pub fn rebound_u(u: f64) -> PlasticRebound {
+    if u.is_nan() {
+        return PlasticRebound {
+            e: f64::NAN,
+            one_minus_e: f64::NAN,
+        };
+    }
+    if u <= 1.0 {
+        return PlasticRebound {
+            e: 1.0,
+            one_minus_e: 0.0,
+        };
+    }
+    let w = w_of(u);
+    let q = (2.0 / 15.0) * (30.0 * (u - 1.0) * (u + 1.0) / (w + 5.0));
+    let q = if u < 1e100 { q } else { (2.0 / 15.0) * w };
+    let e = (1.0 + 1.5 * q) / (u * (1.0 + q).powf(0.25));
+    let one_minus_e = if e > 0.5 {
+        let eta = 30.0 * (u - 1.0) * (u + 1.0) / (w + 5.0);
+        let w2p5 = w * w + 5.0;
+        let cubic = ((2.0 * w + 3.4) * w + 4.0) * w + 5.0;
+        let one_minus_e4 = eta * eta * cubic / (w2p5 * w2p5 * (2.0 * w + 5.0));
+        one_minus_e4 / ((1.0 + e) * (1.0 + e * e))
+    } else {
+        1.0 - e
+    };
+    PlasticRebound { e, one_minus_e }
+}
+
+/// e(u) alone; see [`rebound_u`].
+pub fn e_of_u(u: f64) -> f64 {
+    rebound_u(u).e
+}
+
+/// The same closed form with q = -2/3 + (2/15) sqrt(30 u^2 - 5) and 1 - e taken as 1 - e: correct
+/// in exact arithmetic but it loses digits as u -> 1 (kept for the work-precision chart).
+pub fn rebound_u_naive(u: f64) -> PlasticRebound {
+    if u <= 1.0 {
+        return PlasticRebound {
+            e: 1.0,
+            one_minus_e: 0.0,
+        };
+    }
+    let q = -2.0 / 3.0 + (2.0 / 15.0) * (30.0 * u * u - 5.0).sqrt();
+    let e = (1.0 + 1.5 * q) / (u * (1.0 + q).powf(0.25));
+    PlasticRebound {
+        e,
+        one_minus_e: 1.0 - e,
+    }
+}
+
+/// A plastic contact with yield stress sigma_y, in SI units.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plastic {
+    pub contact: Contact,
+    pub sigma_y_pa: f64,
+}
+
+impl Plastic {
+    pub fn new(contact: Contact, sigma_y_pa: f64) -> Result<Self> {
+        positive("yield stress sigma_y (Pa)", sigma_y_pa)?;
+        Ok(Plastic {
+            contact,
+            sigma_y_pa,
+        })
+    }
+
+    /// V_Y of Eq. (15), generalised to any pair through W_y = (1/2) m_red V_Y^2.
+    pub fn yield_velocity_m_s(&self) -> f64 {
+        self.contact.yield_velocity_m_s(self.sigma_y_pa)
+    }
+
+    /// e and 1 - e at normal impact speed `v_m_s` (closed form).
+    pub fn rebound(&self, v_m_s: f64) -> Result<PlasticRebound> {
+        positive("impact speed (m/s)", v_m_s)?;
+        Ok(rebound_u(v_m_s / self.yield_velocity_m_s()))
+    }
+
+    /// e from the dimensional work balances of Eqs. (12)-(17), without the closed form: the
+    /// loading work W_y + P_y X + (s/2) X^2 = (1/2) m_red V^2 is solved for X = delta* - delta_y,
+    /// then P* = P_y + s X, a*^2 = R~ delta*, W_r = 3 P*^2/(10 E* a*) and e^2 = W_r / ((1/2) m_red V^2).
+    /// An independent check of [`rebound_u`], used in tests; it cancels as u -> 1.
+    pub fn rebound_by_work_balance(&self, v_m_s: f64) -> Result<f64> {
+        positive("impact speed (m/s)", v_m_s)?;
+        let c = &self.contact;
+        let ke = 0.5 * c.m_red_kg * v_m_s * v_m_s;
+        let wy = c.yield_work_j(self.sigma_y_pa);
+        if ke <= wy {
+            return Ok(1.0);
+        }
+        let dy = c.yield_overlap_m(self.sigma_y_pa);
+        let py = c.hertz_force_n(dy);
+        let s = c.plastic_slope_n_m(self.sigma_y_pa);
+        let x = 2.0 * (ke - wy) / (py + (py * py + 2.0 * s * (ke - wy)).sqrt());
+        let p_star = py + s * x;
+        let a_star = (c.r_eff_m * (dy + x)).sqrt();
+        let wr = 3.0 * p_star * p_star / (10.0 * c.e_star_pa * a_star);
+        let e = (wr / ke).sqrt();
+        if e.is_finite() {
+            Ok(e)
+        } else {
+            Err(Error::InvalidParameter {
+                name: "impact speed (m/s)",
+                value: v_m_s,
+                expected: "a speed whose work balance is finite",
+            })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn asymptote_constant() {
+        // PHYSICS.md §3: C = 1.18499299221237 (the paper's 1.18).
+        assert!((asymptote_c() - 1.18499299221237).abs() < 1e-13);
+        let u = 1e12;
+        assert!((e_of_u(u) * u.powf(0.25) / asymptote_c() - 1.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn continuous_at_yield() {
+        assert_eq!(e_of_u(1.0), 1.0);
+        let r = rebound_u(1.0 + 1e-9);
+        assert!(r.one_minus_e > 0.0 && r.one_minus_e < 1e-16);
+    }
+
+    #[test]
+    fn naive_form_loses_digits_near_yield() {
+        let u = 1.0 + 1e-6;
+        let good = rebound_u(u).one_minus_e;
+        let naive = rebound_u_naive(u).one_minus_e;
+        assert!(((naive - good) / good).abs() > 1e-6, "{good} {naive}");
+    }
+}

@@ -1,0 +1,66 @@
+//! Master curve: e(kappa) for each end-of-contact rule as a fast piecewise Chebyshev table.
+//!
+//! **What**: e depends on the dimensionless damping kappa alone (PHYSICS.md §2), so one function
+//! per rule serves every material, size and speed. We tabulate h(s) = (1 - e)/kappa as a function
+//! of s = kappa^(1/2) on [0, `S_MAX`]: h is analytic in s down to s = 0 (h(0) = C1 = 1.1534...),
+//! including the half-integer powers of kappa that the force rule's expansion has, and
+//! 1 - e = kappa h keeps its relative accuracy as kappa -> 0.
+//!
+//! **How**: `PIECES` equal intervals in s, each a Chebyshev interpolant of degree `DEGREE` through
+//! the ODE at its tightest setting ([`super::OdeSettings::REFERENCE`]) at Chebyshev nodes, made by
+//! `examples/gen_master_curve.rs` (committed) and checked by it at points between the nodes. The
+//! generator's measured maximum errors are [`MAX_ABS_ERROR_E`] and [`MAX_REL_ERROR_ONE_MINUS_E`];
+//! tests/viscoelastic.rs checks the table against the independent mpmath reference values.
+//!
+//! **Outside** [0, `KAPPA_MAX`] there is no table: [`restitution_master`] returns `None` and
+//! [`super::restitution`] falls back to the ODE.
+
+use super::master_table as table;
+use super::{ContactEnd, Restitution};
+
+pub use table::{MAX_ABS_ERROR_E, MAX_REL_ERROR_ONE_MINUS_E};
+
+/// Largest kappa the table covers.
+pub const KAPPA_MAX: f64 = table::S_MAX * table::S_MAX;
+/// Width of one piece in s = kappa^(1/2).
+pub const PIECE_WIDTH: f64 = table::S_MAX / table::PIECES as f64;
+
+/// Clenshaw summation of sum_j c_j T_j(x), x in [-1, 1].
+#[inline]
+pub fn clenshaw(c: &[f64], x: f64) -> f64 {
+    let (mut b1, mut b2) = (0.0, 0.0);
+    let x2 = 2.0 * x;
+    for &cj in c.iter().skip(1).rev() {
+        let b0 = cj + x2 * b1 - b2;
+        b2 = b1;
+        b1 = b0;
+    }
+    c[0] + x * b1 - b2
+}
+
+/// Piece index and local coordinate in [-1, 1] of s.
+#[inline]
+pub fn locate(s: f64) -> (usize, f64) {
+    let u = s / PIECE_WIDTH;
+    let i = (u as usize).min(table::PIECES - 1);
+    (i, 2.0 * (u - i as f64) - 1.0)
+}
+
+/// e(kappa) from the table, or `None` when kappa is outside [0, KAPPA_MAX] (or NaN).
+#[inline]
+pub fn restitution_master(kappa: f64, rule: ContactEnd) -> Option<Restitution> {
+    if !(0.0..=KAPPA_MAX).contains(&kappa) {
+        return None;
+    }
+    let (i, x) = locate(kappa.sqrt());
+    let coeffs = match rule {
+        ContactEnd::Overlap => &table::OVERLAP[i],
+        ContactEnd::Force => &table::FORCE[i],
+    };
+    let one_minus_e = kappa * clenshaw(coeffs, x);
+    Some(Restitution {
+        e: 1.0 - one_minus_e,
+        one_minus_e,
+        rhs_evals: 0,
+    })
+}
