@@ -5,5 +5,6 @@ pub mod contact;
 pub mod data;
 pub mod error;
 pub mod models;
+pub mod plot;
 
 pub use error::{Error, Result};
