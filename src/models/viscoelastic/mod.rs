@@ -580,12 +580,10 @@ fn solve(kappa: f64, rule: ContactEnd, settings: &OdeSettings, extrema: bool) ->
             let (x, p) = x_p(var, s, &y);
             force_max = force(kappa, x, p);
         }
-        if rule == ContactEnd::Force {
-            if let Some(b) = &phase.brackets[Event::ForceZero as usize] {
-                let (s, y, n) = locate(kappa, var, Event::ForceZero, b, settings)?;
-                *evals += n;
-                return Ok(Some((s, y)));
-            }
+        if let (ContactEnd::Force, Some(b)) = (rule, &phase.brackets[Event::ForceZero as usize]) {
+            let (s, y, n) = locate(kappa, var, Event::ForceZero, b, settings)?;
+            *evals += n;
+            return Ok(Some((s, y)));
         }
         Ok(None)
     };
@@ -696,18 +694,13 @@ pub struct Restitution {
 }
 
 /// How e(kappa) is evaluated.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum VmMethod {
     /// The master-curve table inside its range, the default ODE outside it.
+    #[default]
     Master,
     /// The ODE at the given setting, for every point.
     Ode(OdeSettings),
-}
-
-impl Default for VmMethod {
-    fn default() -> Self {
-        VmMethod::Master
-    }
 }
 
 /// e(kappa) by the chosen method (the master curve falls back to the default ODE above
