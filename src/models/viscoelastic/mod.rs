@@ -384,6 +384,10 @@ fn integrate(
         u32::MAX
     };
     let h_max = (s1 - s0).abs();
+    // Every phase variable is O(1) over a contact, so a first step of 0.05 (or the whole span of a
+    // short refinement) is safe; the solver's own first guess starts near 1e-6 at r = 0, where the
+    // right side vanishes, and wastes steps growing from there.
+    let h0 = (s1 - s0).signum() * h_max.min(0.05);
     macro_rules! adaptive {
         ($solver:ident, $beta:expr) => {{
             let mut solver = $solver::from_param(
@@ -399,7 +403,7 @@ fn integrate(
                 0.333,
                 6.0,
                 h_max,
-                0.0,
+                h0,
                 settings.max_steps,
                 n_stiff,
                 OutputType::Sparse,
