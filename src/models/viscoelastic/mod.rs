@@ -40,6 +40,7 @@ use std::str::FromStr;
 
 pub mod master;
 mod master_table;
+pub mod series;
 
 // The fourth component carries the independent variable, so that the system is autonomous:
 // ode_solvers 0.6's Dop853 tableau has c_12 = 0 where DOP853 needs c_12 = 1, which silently
