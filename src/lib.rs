@@ -1,6 +1,7 @@
 //! `restitution`: the coefficient of restitution of colliding spheres after Labous, Rosato & Dave,
 //! Phys. Rev. E 56, 5717 (1997). Physics modules are pure: no CLI, plotting or I/O.
 
+pub mod bench;
 pub mod contact;
 pub mod data;
 pub mod error;

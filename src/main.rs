@@ -18,6 +18,8 @@ struct Cli {
 enum Command {
     /// e(v) from the viscoelastic or plastic model
     Predict(cli::predict::Args),
+    /// Speed against accuracy: work-precision chart and stability map of every method
+    Bench(cli::bench::Args),
 }
 
 fn main() -> ExitCode {
@@ -42,6 +44,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Predict(args) => cli::predict::run(args),
+        Command::Bench(args) => cli::bench::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

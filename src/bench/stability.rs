@@ -1,0 +1,242 @@
+//! The stability map: where each method fails over kappa (and u), and how.
+//!
+//! Each cell evaluates one method at one point and compares with the reference. Its outcome is one
+//! of: `ok` (error <= [`MAP_TOL`]); a silent failure, i.e. a number returned that is wrong
+//! (`inaccurate`: error above MAP_TOL; `nan`: not finite); or an error value, classified as the
+//! integrators report it (`max_steps`: no termination within the step budget, `step_underflow`,
+//! `stiffness`, `non_finite`, `unphysical`, `phase_incomplete`) or `refused` (an approximation
+//! outside the range where its error bound meets MAP_TOL). The error of a cell is
+//! |e - e_ref| / min(1, (1 - e)_ref): at once the absolute error of e and the relative error of
+//! 1 - e, which is what matters as kappa -> 0 or u -> 1.
+
+use super::methods::{PmSpec, VmSpec};
+use super::reference::{PmRef, vm_dense_reference};
+use crate::error::{Error, IntegrationFailure};
+use crate::models::viscoelastic::ContactEnd;
+
+/// The accuracy a cell must reach to count as `ok`.
+pub const MAP_TOL: f64 = 1e-6;
+
+/// What happened in one cell.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Outcome {
+    Ok,
+    /// A finite number with error above [`MAP_TOL`], returned as if it were right.
+    Inaccurate,
+    /// NaN or infinity returned as if it were right.
+    NotFinite,
+    /// An approximation declined: its error bound does not meet the requested accuracy.
+    Refused,
+    /// The integration gave up with an error value.
+    Failed(IntegrationFailure),
+    /// Any other error value.
+    OtherError,
+}
+
+impl Outcome {
+    pub fn name(self) -> &'static str {
+        match self {
+            Outcome::Ok => "ok",
+            Outcome::Inaccurate => "inaccurate",
+            Outcome::NotFinite => "nan",
+            Outcome::Refused => "refused",
+            Outcome::Failed(f) => f.name(),
+            Outcome::OtherError => "error",
+        }
+    }
+
+    /// A wrong number returned without an error value.
+    pub fn is_silent_failure(self) -> bool {
+        matches!(self, Outcome::Inaccurate | Outcome::NotFinite)
+    }
+
+    /// Every outcome, in the order of the figure's legend.
+    pub const ALL: [Outcome; 11] = [
+        Outcome::Ok,
+        Outcome::Inaccurate,
+        Outcome::NotFinite,
+        Outcome::Refused,
+        Outcome::Failed(IntegrationFailure::MaxSteps),
+        Outcome::Failed(IntegrationFailure::StepSizeUnderflow),
+        Outcome::Failed(IntegrationFailure::Stiffness),
+        Outcome::Failed(IntegrationFailure::NonFinite),
+        Outcome::Failed(IntegrationFailure::Unphysical),
+        Outcome::Failed(IntegrationFailure::PhaseIncomplete),
+        Outcome::OtherError,
+    ];
+}
+
+/// Whether a method is one a user computes e with, or a comparator kept to show a failure mode.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Role {
+    /// A way to compute e that the library offers: it must never return a wrong number silently.
+    Production,
+    /// A second method for comparison (quadrature) or the demonstration of a failure (naive q).
+    Comparator,
+}
+
+/// One cell of the map.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cell {
+    pub model: &'static str,
+    pub method: String,
+    pub setting: String,
+    pub role: Role,
+    /// `overlap`, `force` or `-`.
+    pub rule: String,
+    /// kappa (vm) or u (pm).
+    pub x: f64,
+    pub outcome: Outcome,
+    /// See the module docs; NaN when the method gave an error value.
+    pub error: f64,
+    /// The error value's message, or why a number is wrong.
+    pub detail: String,
+}
+
+fn classify_error(err: &Error) -> Outcome {
+    match err {
+        Error::Integration { .. } => Outcome::Failed(
+            err.integration_failure()
+                .unwrap_or(IntegrationFailure::Other),
+        ),
+        Error::InvalidParameter { expected, .. } if expected.contains("error bound") => {
+            Outcome::Refused
+        }
+        _ => Outcome::OtherError,
+    }
+}
+
+fn classify_number(e: f64, one_minus_e: f64, e_ref: f64, ome_ref: f64) -> (Outcome, f64, String) {
+    if !(e.is_finite() && one_minus_e.is_finite()) {
+        return (
+            Outcome::NotFinite,
+            f64::NAN,
+            format!("e = {e}, 1 - e = {one_minus_e}"),
+        );
+    }
+    let scale = ome_ref.clamp(f64::MIN_POSITIVE, 1.0);
+    // The worse of e and 1 - e: they are computed separately by some methods.
+    let err = ((e - e_ref).abs().max((one_minus_e - ome_ref).abs())) / scale;
+    if err <= MAP_TOL {
+        (Outcome::Ok, err, String::new())
+    } else {
+        (
+            Outcome::Inaccurate,
+            err,
+            format!("e = {e} (reference {e_ref}), 1 - e = {one_minus_e} (reference {ome_ref})"),
+        )
+    }
+}
+
+/// `per_decade` log-spaced kappa values from 1e-8 to 10^`max_decade` inclusive.
+pub fn kappa_grid(per_decade: usize, max_decade: i32) -> Vec<f64> {
+    let n = (max_decade + 8) as usize * per_decade;
+    (0..=n)
+        .map(|i| {
+            let d = -8.0 + i as f64 / per_decade as f64;
+            // Exact powers of ten where the grid hits a decade.
+            if i % per_decade == 0 {
+                format!("1e{}", d.round() as i32)
+                    .parse()
+                    .unwrap_or(10f64.powf(d))
+            } else {
+                10f64.powf(d)
+            }
+        })
+        .collect()
+}
+
+/// The viscoelastic map: every spec, both rules (where it applies), every kappa.
+/// Fails only if the reference itself cannot be computed.
+pub fn vm_map(specs: &[(VmSpec, Role)], kappas: &[f64]) -> crate::error::Result<Vec<Cell>> {
+    let mut refs = Vec::new();
+    for rule in ContactEnd::ALL {
+        for &kappa in kappas {
+            let (e_ref, ome_ref, _) = vm_dense_reference(kappa, rule)?;
+            refs.push((rule, kappa, e_ref, ome_ref));
+        }
+    }
+    let mut cells = Vec::new();
+    for (spec, role) in specs {
+        for rule in ContactEnd::ALL {
+            if !spec.applies(rule) {
+                continue;
+            }
+            for &(_, kappa, e_ref, ome_ref) in refs.iter().filter(|r| r.0 == rule) {
+                let (outcome, error, detail) = match spec.eval(kappa, rule) {
+                    Ok(r) => classify_number(r.e, r.one_minus_e, e_ref, ome_ref),
+                    Err(err) => (classify_error(&err), f64::NAN, err.to_string()),
+                };
+                cells.push(Cell {
+                    model: "vm",
+                    method: spec.method(),
+                    setting: spec.setting(),
+                    role: *role,
+                    rule: rule.name().into(),
+                    x: kappa,
+                    outcome,
+                    error,
+                    detail,
+                });
+            }
+        }
+    }
+    Ok(cells)
+}
+
+/// The plastic map over the reference points with u > 1.
+pub fn pm_map(specs: &[(PmSpec, Role)], refs: &[PmRef]) -> Vec<Cell> {
+    let mut cells = Vec::new();
+    for r in refs.iter().filter(|r| r.u > 1.0) {
+        for (spec, role) in specs {
+            let (outcome, error, detail) = match spec.eval(r.u) {
+                Ok(got) => classify_number(got.e, got.one_minus_e, r.e, r.one_minus_e),
+                Err(err) => (classify_error(&err), f64::NAN, err.to_string()),
+            };
+            cells.push(Cell {
+                model: "pm",
+                method: spec.method(),
+                setting: spec.setting(),
+                role: *role,
+                rule: "-".into(),
+                x: r.u,
+                outcome,
+                error,
+                detail,
+            });
+        }
+    }
+    cells
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn grid_has_exact_decades() {
+        let g = kappa_grid(4, 2);
+        assert_eq!(g.len(), 41);
+        assert_eq!(g[0], 1e-8);
+        assert_eq!(g[40], 100.0);
+        assert_eq!(g[32], 1.0);
+    }
+
+    #[test]
+    fn numbers_are_classified_by_the_combined_error() {
+        // 1 - e = 1e-8 known to 1e-15 absolute: relative 1e-7, ok.
+        assert_eq!(
+            classify_number(1.0 - 1e-8, 1e-8 + 1e-15, 1.0 - 1e-8, 1e-8).0,
+            Outcome::Ok
+        );
+        // 1 - e off by 1e-13 at 1 - e = 1e-8: relative 1e-5, inaccurate.
+        assert_eq!(
+            classify_number(1.0 - 1e-8, 1e-8 + 1e-13, 1.0 - 1e-8, 1e-8).0,
+            Outcome::Inaccurate
+        );
+        assert_eq!(
+            classify_number(f64::NAN, 0.5, 0.5, 0.5).0,
+            Outcome::NotFinite
+        );
+    }
+}

@@ -1,0 +1,80 @@
+//! `restitution bench`: speed against accuracy for every way the toolkit computes e.
+//!
+//! ```text
+//! restitution bench [--out DIR] [--quick]
+//! ```
+//! Writes into DIR (default `reports/bench`, created if missing), all files or none:
+//! `work_precision.csv` (model,method,setting,knob,rule,error,error_rel_e,error_rel_one_minus_e,
+//! ns_per_eval,rhs_evals,points,failed), `work_precision_points.csv` (every evaluation behind it),
+//! `work_precision.svg`, `stability.csv`, `stability.svg` and `summary.md` (targets, RK4 order,
+//! default-setting candidates, where each method fails). Prints the summary. `--quick` measures
+//! fewer settings and points with shorter timing batches (well under a minute).
+
+use super::CliResult;
+use restitution::bench::{self, BenchConfig};
+use restitution::data::write_all_atomic;
+use restitution::plot;
+use std::path::PathBuf;
+
+/// Speed against accuracy: work-precision chart, stability map, targets
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Output directory
+    #[arg(long, value_name = "DIR", default_value = "reports/bench")]
+    out: PathBuf,
+    /// Fewer settings, points and repeats (under a minute)
+    #[arg(long)]
+    quick: bool,
+}
+
+/// The CPU model and core count, for the report (Linux; "unknown" elsewhere).
+fn machine() -> String {
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
+        .unwrap_or_else(|| "unknown CPU".into());
+    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    format!(
+        "{cpu}, {cores} logical CPUs, {} {}",
+        std::env::consts::OS,
+        std::env::consts::ARCH
+    )
+}
+
+pub fn run(args: Args) -> CliResult {
+    let cfg = BenchConfig { quick: args.quick };
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("--out {}: cannot create directory: {e}", args.out.display()))?;
+    let report = bench::run(&cfg).map_err(|e| e.to_string())?;
+    let summary = report.summary_markdown(&machine());
+    let wp_svg = plot::bench::work_precision_svg(&report)
+        .map_err(|e| format!("drawing work_precision.svg: {e}"))?;
+    let st_svg =
+        plot::bench::stability_svg(&report).map_err(|e| format!("drawing stability.svg: {e}"))?;
+    let files = vec![
+        (
+            args.out.join("work_precision.csv"),
+            report.work_precision_csv().into_bytes(),
+        ),
+        (
+            args.out.join("work_precision_points.csv"),
+            report.points_csv().into_bytes(),
+        ),
+        (args.out.join("work_precision.svg"), wp_svg.into_bytes()),
+        (
+            args.out.join("stability.csv"),
+            report.stability_csv().into_bytes(),
+        ),
+        (args.out.join("stability.svg"), st_svg.into_bytes()),
+        (args.out.join("summary.md"), summary.clone().into_bytes()),
+    ];
+    write_all_atomic(&files).map_err(|e| format!("writing into {}: {e}", args.out.display()))?;
+    print!("{summary}");
+    println!("\nwrote {} files into {}", files.len(), args.out.display());
+    Ok(())
+}

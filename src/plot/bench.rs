@@ -1,0 +1,603 @@
+//! Figures of `restitution bench`: the work-precision chart (four panels) and the stability map.
+
+use crate::bench::stability::{Cell, Outcome};
+use crate::bench::{BenchReport, WpRow};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
+
+type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+
+/// Errors below this are drawn at it (log axes have no zero).
+const ERROR_FLOOR: f64 = 1e-17;
+/// Relative errors above this (no correct digit left) are drawn at it.
+const REL_ERROR_CAP: f64 = 10.0;
+
+fn method_color(method: &str) -> RGBColor {
+    match method {
+        "dop853" => RGBColor(0, 90, 181),
+        "dop853+extrema" => RGBColor(120, 160, 230),
+        "dopri5" => RGBColor(220, 50, 32),
+        "rk4" => RGBColor(0, 150, 60),
+        "master" => RGBColor(0, 0, 0),
+        "series" => RGBColor(230, 140, 0),
+        "pade" => RGBColor(150, 60, 170),
+        "closed form" => RGBColor(0, 0, 0),
+        "naive q" => RGBColor(220, 50, 32),
+        "quadrature" => RGBColor(0, 90, 181),
+        _ => RGBColor(100, 100, 100),
+    }
+}
+
+fn floor(e: f64) -> f64 {
+    e.max(ERROR_FLOOR)
+}
+
+fn err_str<E: std::fmt::Debug>(e: E) -> String {
+    format!("{e:?}")
+}
+
+/// Methods in the order of first appearance.
+fn methods_of<'a>(rows: impl Iterator<Item = &'a WpRow>) -> Vec<String> {
+    let mut v: Vec<String> = Vec::new();
+    for r in rows {
+        if !v.contains(&r.method) {
+            v.push(r.method.clone());
+        }
+    }
+    v
+}
+
+/// A line (or a single point) per method: the points sorted by x.
+fn draw_lines<X: Fn(&WpRow) -> f64, Y: Fn(&WpRow) -> f64>(
+    chart: &mut ChartContext<
+        SVGBackend,
+        Cartesian2d<
+            plotters::coord::combinators::LogCoord<f64>,
+            plotters::coord::combinators::LogCoord<f64>,
+        >,
+    >,
+    rows: &[&WpRow],
+    x: X,
+    y: Y,
+    dashed: bool,
+    label_suffix: &str,
+) -> Result<(), String> {
+    for m in methods_of(rows.iter().copied()) {
+        let color = method_color(&m);
+        let mut pts: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| r.method == m)
+            .map(|r| (x(r), floor(y(r))))
+            .filter(|(a, b)| a.is_finite() && *a > 0.0 && b.is_finite())
+            .collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        if pts.is_empty() {
+            continue;
+        }
+        let style = ShapeStyle::from(&color).stroke_width(2);
+        let label = format!("{m}{label_suffix}");
+        if dashed {
+            chart
+                .draw_series(DashedLineSeries::new(pts.clone(), 8, 5, style))
+                .map_err(err_str)?
+                .label(label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 8, y)], style));
+            chart
+                .draw_series(
+                    pts.iter()
+                        .map(|&p| TriangleMarker::new(p, 5, ShapeStyle::from(&color).filled())),
+                )
+                .map_err(err_str)?;
+        } else {
+            chart
+                .draw_series(LineSeries::new(pts.clone(), style))
+                .map_err(err_str)?
+                .label(label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+            chart
+                .draw_series(
+                    pts.iter()
+                        .map(|&p| Circle::new(p, 4, ShapeStyle::from(&color).filled())),
+                )
+                .map_err(err_str)?;
+        }
+    }
+    Ok(())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn log_panel<'a>(
+    area: &Area<'a>,
+    title: &str,
+    x_desc: &str,
+    y_desc: &str,
+    x: (f64, f64),
+    y: (f64, f64),
+) -> Result<
+    ChartContext<
+        'a,
+        SVGBackend<'a>,
+        Cartesian2d<
+            plotters::coord::combinators::LogCoord<f64>,
+            plotters::coord::combinators::LogCoord<f64>,
+        >,
+    >,
+    String,
+> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 26))
+        .margin(12)
+        .x_label_area_size(55)
+        .y_label_area_size(85)
+        .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
+        .map_err(err_str)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .axis_desc_style(("sans-serif", 22))
+        .label_style(("sans-serif", 18))
+        .x_label_formatter(&|v| format!("{v:.0e}"))
+        .y_label_formatter(&|v| format!("{v:.0e}"))
+        .light_line_style(WHITE.mix(0.0))
+        .draw()
+        .map_err(err_str)?;
+    Ok(chart)
+}
+
+fn range_of(vals: impl Iterator<Item = f64>, pad: f64) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in vals.filter(|v| v.is_finite() && *v > 0.0) {
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if !lo.is_finite() {
+        return (1e-3, 1e3);
+    }
+    (lo / pad, hi * pad)
+}
+
+/// `work_precision.svg`: (a) vm error in e against time per evaluation, (b) against right-hand-side
+/// evaluations, (c) pm relative errors against time, (d) RK4's error against its step.
+pub fn work_precision_svg(report: &BenchReport) -> Result<String, String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1600, 1250)).into_drawing_area();
+        root.fill(&WHITE).map_err(err_str)?;
+        let (title, body) = root.split_vertically(50);
+        title
+            .titled(
+                "Work-precision: every way restitution computes e (settings with any failed point left out; errors below 1e-17 drawn at 1e-17)",
+                ("sans-serif", 22),
+            )
+            .map_err(err_str)?;
+        let panels = body.split_evenly((2, 2));
+
+        let vm: Vec<&WpRow> = report
+            .rows
+            .iter()
+            .filter(|r| r.model == "vm" && r.rule == "all" && r.failed == 0)
+            .collect();
+        let y_vm = (
+            ERROR_FLOOR / 3.0,
+            range_of(vm.iter().map(|r| r.error), 3.0).1.max(1.0),
+        );
+        // (a)
+        let x_a = range_of(vm.iter().map(|r| r.ns_per_eval), 3.0);
+        let mut a = log_panel(
+            &panels[0],
+            "(a) viscoelastic: error vs time (kappa 1e-4..5, both rules)",
+            "time per evaluation (ns)",
+            "max |error in e|",
+            x_a,
+            y_vm,
+        )?;
+        draw_lines(&mut a, &vm, |r| r.ns_per_eval, |r| r.error, false, "")?;
+        // The approximations' settings are not a monotone knob: name each point.
+        for (i, r) in vm
+            .iter()
+            .filter(|r| r.method == "series" || r.method == "pade")
+            .enumerate()
+        {
+            // Alternate sides so that neighbouring labels do not overlap.
+            let (h, text) = if i % 2 == 0 {
+                (HPos::Left, format!("  {}", r.setting))
+            } else {
+                (HPos::Right, format!("{}  ", r.setting))
+            };
+            let style = ("sans-serif", 15)
+                .into_font()
+                .into_text_style(&panels[0])
+                .pos(Pos::new(h, VPos::Center));
+            a.draw_series(std::iter::once(Text::new(
+                text,
+                (r.ns_per_eval, floor(r.error)),
+                style,
+            )))
+            .map_err(err_str)?;
+        }
+        a.configure_series_labels()
+            .position(SeriesLabelPosition::LowerMiddle)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 17))
+            .draw()
+            .map_err(err_str)?;
+
+        // (b)
+        let ode: Vec<&WpRow> = vm.iter().copied().filter(|r| r.rhs_evals > 0.0).collect();
+        let x_b = range_of(ode.iter().map(|r| r.rhs_evals), 1.5);
+        let mut b = log_panel(
+            &panels[1],
+            "(b) viscoelastic ODE: error vs right-hand-side evaluations",
+            "right-hand-side evaluations per e",
+            "max |error in e|",
+            x_b,
+            y_vm,
+        )?;
+        draw_lines(&mut b, &ode, |r| r.rhs_evals, |r| r.error, false, "")?;
+        b.configure_series_labels()
+            .position(SeriesLabelPosition::UpperMiddle)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 17))
+            .draw()
+            .map_err(err_str)?;
+
+        // (c)
+        let pm: Vec<&WpRow> = report
+            .rows
+            .iter()
+            .filter(|r| r.model == "pm" && r.failed == 0)
+            .collect();
+        let x_c = range_of(pm.iter().map(|r| r.ns_per_eval), 2.0);
+        let y_c = (ERROR_FLOOR / 3.0, REL_ERROR_CAP * 1e4);
+        let mut c = log_panel(
+            &panels[2],
+            "(c) plastic: error vs time (u in (1, 1e12]; above 10 drawn at 10)",
+            "time per evaluation (ns)",
+            "max relative error",
+            x_c,
+            y_c,
+        )?;
+        let cap = |x: f64| if x.is_nan() { x } else { x.min(REL_ERROR_CAP) };
+        draw_lines(
+            &mut c,
+            &pm,
+            |r| r.ns_per_eval,
+            |r| cap(r.error_rel_e),
+            false,
+            ": e",
+        )?;
+        draw_lines(
+            &mut c,
+            &pm,
+            |r| r.ns_per_eval,
+            |r| cap(r.error_rel_one_minus_e),
+            true,
+            ": 1 - e",
+        )?;
+        c.configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 17))
+            .draw()
+            .map_err(err_str)?;
+
+        // (d)
+        let rk4: Vec<&WpRow> = report
+            .rows
+            .iter()
+            .filter(|r| r.method == "rk4" && (r.rule == "overlap" || r.rule == "force"))
+            .filter(|r| r.failed == 0)
+            .collect();
+        let x_d = range_of(rk4.iter().map(|r| r.knob), 1.5);
+        let y_d = range_of(rk4.iter().map(|r| floor(r.error)), 5.0);
+        let mut d = log_panel(
+            &panels[3],
+            "(d) fixed-step RK4 in the r/t/r variables: error vs step",
+            "step h (r or t units)",
+            "max |error in e|",
+            x_d,
+            y_d,
+        )?;
+        for (rule, color, dashed) in [
+            ("overlap", RGBColor(0, 150, 60), false),
+            ("force", RGBColor(0, 90, 40), true),
+        ] {
+            let mut pts: Vec<(f64, f64)> = rk4
+                .iter()
+                .filter(|r| r.rule == rule)
+                .map(|r| (r.knob, floor(r.error)))
+                .collect();
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let slope = report
+                .rk4_order
+                .iter()
+                .find(|o| o.0 == rule)
+                .map_or("-".to_string(), |o| format!("{:.2}", o.1));
+            let style = ShapeStyle::from(&color).stroke_width(2);
+            let label = format!("rk4, {rule} rule: fitted slope {slope}");
+            if dashed {
+                d.draw_series(DashedLineSeries::new(pts.clone(), 8, 5, style))
+                    .map_err(err_str)?
+                    .label(label)
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 8, y)], style));
+            } else {
+                d.draw_series(LineSeries::new(pts.clone(), style))
+                    .map_err(err_str)?
+                    .label(label)
+                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], style));
+            }
+            d.draw_series(
+                pts.iter()
+                    .map(|&p| Circle::new(p, 4, ShapeStyle::from(&color).filled())),
+            )
+            .map_err(err_str)?;
+        }
+        // Slope-4 guide through the geometric middle of the data.
+        if let (Some(first), Some(last)) = (rk4.first(), rk4.last()) {
+            let _ = (first, last);
+            let h_mid = (x_d.0 * x_d.1).sqrt();
+            let e_mid = (y_d.0 * y_d.1).sqrt();
+            let guide: Vec<(f64, f64)> = [x_d.0 * 1.5, x_d.1 / 1.5]
+                .iter()
+                .map(|&h| (h, e_mid * (h / h_mid).powi(4)))
+                .filter(|p| p.1 > y_d.0 && p.1 < y_d.1)
+                .collect();
+            let gstyle = ShapeStyle::from(&RGBColor(120, 120, 120)).stroke_width(1);
+            d.draw_series(DashedLineSeries::new(guide, 4, 4, gstyle))
+                .map_err(err_str)?
+                .label("slope 4")
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], gstyle));
+        }
+        d.configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 17))
+            .draw()
+            .map_err(err_str)?;
+        root.present().map_err(err_str)?;
+    }
+    Ok(svg)
+}
+
+fn outcome_color(o: Outcome) -> RGBColor {
+    use crate::error::IntegrationFailure as F;
+    match o {
+        Outcome::Ok => RGBColor(200, 230, 200),
+        Outcome::Inaccurate => RGBColor(230, 30, 30),
+        Outcome::NotFinite => RGBColor(120, 0, 0),
+        Outcome::Refused => RGBColor(200, 200, 200),
+        Outcome::Failed(F::MaxSteps) => RGBColor(40, 80, 200),
+        Outcome::Failed(F::StepSizeUnderflow) => RGBColor(0, 170, 200),
+        Outcome::Failed(F::Stiffness) => RGBColor(150, 60, 170),
+        Outcome::Failed(F::NonFinite) => RGBColor(250, 150, 0),
+        Outcome::Failed(F::Unphysical) => RGBColor(240, 210, 0),
+        Outcome::Failed(F::PhaseIncomplete) => RGBColor(140, 90, 40),
+        Outcome::Failed(F::Other) | Outcome::OtherError => RGBColor(90, 90, 90),
+    }
+}
+
+fn outcome_label(o: Outcome) -> &'static str {
+    use crate::error::IntegrationFailure as F;
+    match o {
+        Outcome::Ok => "ok (error <= 1e-6)",
+        Outcome::Inaccurate => "WRONG NUMBER: error > 1e-6, no error value",
+        Outcome::NotFinite => "WRONG NUMBER: NaN, no error value",
+        Outcome::Refused => "refused: error bound above 1e-6 (error value)",
+        Outcome::Failed(F::MaxSteps) => "no termination: step budget spent (error value)",
+        Outcome::Failed(F::StepSizeUnderflow) => "step-size underflow (error value)",
+        Outcome::Failed(F::Stiffness) => "stiffness detected (error value)",
+        Outcome::Failed(F::NonFinite) => "state not finite (error value)",
+        Outcome::Failed(F::Unphysical) => "e outside (0, 1] (error value)",
+        Outcome::Failed(F::PhaseIncomplete) => "phase did not end (error value)",
+        Outcome::Failed(F::Other) | Outcome::OtherError => "other error value",
+    }
+}
+
+/// Row labels (method, setting, rule) in first-appearance order, and each cell's row.
+fn map_rows(cells: &[&Cell]) -> Vec<String> {
+    let mut rows: Vec<String> = Vec::new();
+    for c in cells {
+        let k = row_key(c);
+        if !rows.contains(&k) {
+            rows.push(k);
+        }
+    }
+    rows
+}
+
+fn row_key(c: &Cell) -> String {
+    let setting = if c.setting == "-" {
+        String::new()
+    } else {
+        format!(" {}", c.setting)
+    };
+    let rule = if c.rule == "-" {
+        String::new()
+    } else {
+        format!(" [{}]", c.rule)
+    };
+    let role = if c.role == crate::bench::stability::Role::Comparator {
+        " (comparator)"
+    } else {
+        ""
+    };
+    format!("{}{setting}{rule}{role}", c.method)
+}
+
+/// Cell edges in log10(x): midpoints between neighbouring grid values.
+fn edges(xs: &[f64]) -> Vec<f64> {
+    let l: Vec<f64> = xs.iter().map(|x| x.log10()).collect();
+    let mut e = Vec::with_capacity(l.len() + 1);
+    for i in 0..=l.len() {
+        let v = if i == 0 {
+            l[0] - (l.get(1).map_or(0.5, |n| n - l[0])) / 2.0
+        } else if i == l.len() {
+            l[i - 1]
+                + (l[i - 1] - l.get(i.wrapping_sub(2)).copied().unwrap_or(l[i - 1] - 1.0)) / 2.0
+        } else {
+            0.5 * (l[i - 1] + l[i])
+        };
+        e.push(v);
+    }
+    e
+}
+
+fn map_panel(
+    area: &Area,
+    title: &str,
+    x_desc: &str,
+    cells: &[&Cell],
+    x_of: impl Fn(&Cell) -> f64,
+    mark: Option<(f64, &str)>,
+) -> Result<(), String> {
+    let rows = map_rows(cells);
+    let mut xs: Vec<f64> = cells.iter().map(|c| x_of(c)).collect();
+    xs.sort_by(|a, b| a.total_cmp(b));
+    xs.dedup();
+    let ed = edges(&xs);
+    let n = rows.len() as f64;
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 24))
+        .margin(10)
+        .x_label_area_size(50)
+        .y_label_area_size(420)
+        .build_cartesian_2d(ed[0]..ed[ed.len() - 1], -0.5..(n - 0.5))
+        .map_err(err_str)?;
+    let labels = rows.clone();
+    chart
+        .configure_mesh()
+        .disable_mesh()
+        .x_desc(x_desc)
+        .axis_desc_style(("sans-serif", 20))
+        .label_style(("sans-serif", 16))
+        .x_labels(14)
+        .x_label_formatter(&|v| {
+            if (v - v.round()).abs() < 1e-9 {
+                format!("1e{}", v.round() as i32)
+            } else {
+                String::new()
+            }
+        })
+        .y_labels(rows.len())
+        .y_label_formatter(&|v| {
+            let i = v.round();
+            if (v - i).abs() < 1e-9 && i >= 0.0 && (i as usize) < labels.len() {
+                labels[labels.len() - 1 - i as usize].clone()
+            } else {
+                String::new()
+            }
+        })
+        .draw()
+        .map_err(err_str)?;
+    chart
+        .draw_series(cells.iter().map(|c| {
+            let r = rows.iter().position(|k| *k == row_key(c)).unwrap_or(0);
+            let y = (rows.len() - 1 - r) as f64;
+            let i = xs.iter().position(|&x| x == x_of(c)).unwrap_or(0);
+            Rectangle::new(
+                [(ed[i], y - 0.45), (ed[i + 1], y + 0.45)],
+                ShapeStyle::from(&outcome_color(c.outcome)).filled(),
+            )
+        }))
+        .map_err(err_str)?;
+    if let Some((x, text)) = mark {
+        let lx = x.log10();
+        chart
+            .draw_series(DashedLineSeries::new(
+                vec![(lx, -0.5), (lx, n - 0.5)],
+                6,
+                4,
+                ShapeStyle::from(&BLACK).stroke_width(2),
+            ))
+            .map_err(err_str)?;
+        let style = ("sans-serif", 16)
+            .into_font()
+            .into_text_style(area)
+            .pos(Pos::new(HPos::Right, VPos::Bottom));
+        chart
+            .draw_series(std::iter::once(Text::new(
+                text.to_string(),
+                (lx - 0.05, n - 0.5),
+                style,
+            )))
+            .map_err(err_str)?;
+    }
+    Ok(())
+}
+
+/// `stability.svg`: for each method, setting and rule, the outcome at every kappa (top) and u
+/// (bottom), coloured by how it failed.
+pub fn stability_svg(report: &BenchReport) -> Result<String, String> {
+    let vm: Vec<&Cell> = report.cells.iter().filter(|c| c.model == "vm").collect();
+    let pm: Vec<&Cell> = report.cells.iter().filter(|c| c.model == "pm").collect();
+    let n_vm = map_rows(&vm).len() as u32;
+    let n_pm = map_rows(&pm).len() as u32;
+    let row_px = 34;
+    let vm_h = 100 + n_vm * row_px;
+    let pm_h = 100 + n_pm * row_px;
+    let present: Vec<Outcome> = Outcome::ALL
+        .iter()
+        .copied()
+        .filter(|o| *o == Outcome::Ok || report.cells.iter().any(|c| c.outcome == *o))
+        .collect();
+    let legend_h = 40 + 30 * present.len().div_ceil(2) as u32;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1600, vm_h + pm_h + legend_h + 50))
+            .into_drawing_area();
+        root.fill(&WHITE).map_err(err_str)?;
+        let (title, rest) = root.split_vertically(50);
+        title
+            .titled(
+                "Stability map: where each method fails, and how (threshold: error <= 1e-6 in e and relative in 1 - e)",
+                ("sans-serif", 22),
+            )
+            .map_err(err_str)?;
+        let (top, rest) = rest.split_vertically(vm_h);
+        let (mid, bottom) = rest.split_vertically(pm_h);
+        map_panel(
+            &top,
+            "viscoelastic model: dimensionless damping kappa",
+            "kappa (dimensionless damping)",
+            &vm,
+            |c| c.x,
+            Some((100.0, "end of the master table: kappa = 100")),
+        )?;
+        map_panel(
+            &mid,
+            "plastic model: u = V/V_Y (reference points of the mpmath fixture)",
+            "u - 1",
+            &pm,
+            |c| c.x - 1.0,
+            None,
+        )?;
+        // Legend: two columns of colour boxes.
+        let cols = 2;
+        for (i, o) in present.iter().enumerate() {
+            let (col, row) = ((i % cols) as i32, (i / cols) as i32);
+            let x = 80 + col * 760;
+            let y = 15 + row * 30;
+            bottom
+                .draw(&Rectangle::new(
+                    [(x, y), (x + 24, y + 20)],
+                    ShapeStyle::from(&outcome_color(*o)).filled(),
+                ))
+                .map_err(err_str)?;
+            bottom
+                .draw(&Text::new(
+                    outcome_label(*o).to_string(),
+                    (x + 34, y + 2),
+                    ("sans-serif", 18).into_font(),
+                ))
+                .map_err(err_str)?;
+        }
+        root.present().map_err(err_str)?;
+    }
+    Ok(svg)
+}
