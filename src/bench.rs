@@ -88,13 +88,15 @@ impl BenchConfig {
     pub fn timing(&self) -> TimingPlan {
         if self.quick {
             TimingPlan {
-                repeats: 3,
-                min_batch: Duration::from_millis(2),
+                repeats: 7,
+                min_batch: Duration::from_millis(1),
             }
         } else {
+            // Many short batches rather than a few long ones: on a shared machine the minimum
+            // then more likely comes from a batch nothing else interrupted.
             TimingPlan {
-                repeats: 7,
-                min_batch: Duration::from_millis(20),
+                repeats: 25,
+                min_batch: Duration::from_millis(3),
             }
         }
     }
@@ -461,8 +463,11 @@ impl BenchReport {
     }
 }
 
-/// For each map row (method, setting, rule), its non-`ok` outcomes: (outcome, count, min x, max x).
-pub fn map_failures(cells: &[Cell]) -> Vec<(String, Vec<(stability::Outcome, usize, f64, f64)>)> {
+/// One non-`ok` outcome of a map row: (outcome, count, smallest x, largest x).
+pub type OutcomeSpan = (stability::Outcome, usize, f64, f64);
+
+/// For each map row (method, setting, rule), its non-`ok` outcomes.
+pub fn map_failures(cells: &[Cell]) -> Vec<(String, Vec<OutcomeSpan>)> {
     let mut keys: Vec<String> = Vec::new();
     let key = |c: &Cell| format!("{} {} {} [{}]", c.model, c.method, c.setting, c.rule);
     for c in cells {
@@ -473,7 +478,7 @@ pub fn map_failures(cells: &[Cell]) -> Vec<(String, Vec<(stability::Outcome, usi
     }
     keys.into_iter()
         .map(|k| {
-            let mut out: Vec<(stability::Outcome, usize, f64, f64)> = Vec::new();
+            let mut out: Vec<OutcomeSpan> = Vec::new();
             for c in cells
                 .iter()
                 .filter(|c| key(c) == k && c.outcome != stability::Outcome::Ok)
@@ -503,6 +508,21 @@ fn sci(x: f64) -> String {
 }
 
 impl BenchReport {
+    /// Slopes of log(error) against log(h) between successive RK4 steps for `rule`, labelled by
+    /// the smaller step.
+    pub fn rk4_local_slopes(&self, rule: &str) -> Vec<(f64, f64)> {
+        let mut pts: Vec<(f64, f64)> = self
+            .rows
+            .iter()
+            .filter(|r| r.method == "rk4" && r.rule == rule && r.failed == 0 && r.error > 0.0)
+            .map(|r| (r.knob, r.error))
+            .collect();
+        pts.sort_by(|a, b| b.0.total_cmp(&a.0));
+        pts.windows(2)
+            .map(|w| (w[1].0, (w[0].1 / w[1].1).ln() / (w[0].0 / w[1].0).ln()))
+            .collect()
+    }
+
     /// The largest |error in e| of the master curve over the whole fixture (kappa 1e-8 to 100).
     pub fn master_full_range_error(&self) -> f64 {
         vm_fixture()
@@ -590,9 +610,14 @@ impl BenchReport {
         for (rule, slope, n) in &self.rk4_order {
             let _ = writeln!(
                 s,
-                "- {rule} rule: fitted slope of log(error) against log(h) = {slope:.3} ({n} steps with error in [{}, {}])",
+                "- {rule} rule: fitted slope of log(error) against log(h) = {slope:.3} ({n} steps with error in [{:e}, {:e}]); local slopes from the largest step down: {}",
                 work_precision::ORDER_FIT_MIN_ERROR,
-                work_precision::ORDER_FIT_MAX_ERROR
+                work_precision::ORDER_FIT_MAX_ERROR,
+                self.rk4_local_slopes(rule)
+                    .iter()
+                    .map(|(h, sl)| format!("{sl:.2} (h={})", fmt_num(*h)))
+                    .collect::<Vec<_>>()
+                    .join(", ")
             );
         }
         let rc = &self.reference_check;

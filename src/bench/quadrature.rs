@@ -126,7 +126,8 @@ impl WorkQuadrature {
             let f = hertz + plastic(q) - w_in;
             evals += n;
             let dq = f / (1.0 + 1.5 * q);
-            if !(dq > 0.0) {
+            // Also stops on NaN.
+            if dq.is_nan() || dq <= 0.0 {
                 break;
             }
             q -= dq;

@@ -46,12 +46,27 @@ fn machine() -> String {
     )
 }
 
+/// The 1-minute load average (Linux), or "unknown".
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|t| t.split_whitespace().next().map(str::to_string))
+        .unwrap_or_else(|| "unknown".into())
+}
+
 pub fn run(args: Args) -> CliResult {
     let cfg = BenchConfig { quick: args.quick };
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("--out {}: cannot create directory: {e}", args.out.display()))?;
+    let load_before = load_average();
     let report = bench::run(&cfg).map_err(|e| e.to_string())?;
-    let summary = report.summary_markdown(&machine());
+    let machine = format!(
+        "{}; load average (1 min) {} before, {} after (other processes share the CPUs when it is above 0)",
+        machine(),
+        load_before,
+        load_average()
+    );
+    let summary = report.summary_markdown(&machine);
     let wp_svg = plot::bench::work_precision_svg(&report)
         .map_err(|e| format!("drawing work_precision.svg: {e}"))?;
     let st_svg =

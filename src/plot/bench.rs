@@ -7,6 +7,11 @@ use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+type LogLog = Cartesian2d<
+    plotters::coord::combinators::LogCoord<f64>,
+    plotters::coord::combinators::LogCoord<f64>,
+>;
+type LogChart<'a> = ChartContext<'a, SVGBackend<'a>, LogLog>;
 
 /// Errors below this are drawn at it (log axes have no zero).
 const ERROR_FLOOR: f64 = 1e-17;
@@ -50,13 +55,7 @@ fn methods_of<'a>(rows: impl Iterator<Item = &'a WpRow>) -> Vec<String> {
 
 /// A line (or a single point) per method: the points sorted by x.
 fn draw_lines<X: Fn(&WpRow) -> f64, Y: Fn(&WpRow) -> f64>(
-    chart: &mut ChartContext<
-        SVGBackend,
-        Cartesian2d<
-            plotters::coord::combinators::LogCoord<f64>,
-            plotters::coord::combinators::LogCoord<f64>,
-        >,
-    >,
+    chart: &mut LogChart,
     rows: &[&WpRow],
     x: X,
     y: Y,
@@ -114,17 +113,7 @@ fn log_panel<'a>(
     y_desc: &str,
     x: (f64, f64),
     y: (f64, f64),
-) -> Result<
-    ChartContext<
-        'a,
-        SVGBackend<'a>,
-        Cartesian2d<
-            plotters::coord::combinators::LogCoord<f64>,
-            plotters::coord::combinators::LogCoord<f64>,
-        >,
-    >,
-    String,
-> {
+) -> Result<LogChart<'a>, String> {
     let mut chart = ChartBuilder::on(area)
         .caption(title, ("sans-serif", 26))
         .margin(12)

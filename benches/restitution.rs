@@ -1,0 +1,48 @@
+//! Criterion benches of the evaluations a DEM modeller repeats millions of times (`cargo bench`).
+//! The whole work-precision picture is `restitution bench`; these track the headline numbers.
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use restitution::models::plastic::rebound_u;
+use restitution::models::viscoelastic::{
+    ContactEnd, OdeSettings, VmMethod, restitution, restitution_ode,
+};
+use std::hint::black_box;
+use std::time::Duration;
+
+fn master_curve(c: &mut Criterion) {
+    let mut g = c.benchmark_group("master_e_of_kappa");
+    for kappa in [1e-3, 0.1, 1.0, 10.0] {
+        for rule in ContactEnd::ALL {
+            g.bench_with_input(BenchmarkId::new(rule.name(), kappa), &kappa, |b, &k| {
+                b.iter(|| restitution(black_box(k), rule, &VmMethod::Master))
+            });
+        }
+    }
+    g.finish();
+}
+
+fn ode_default(c: &mut Criterion) {
+    let mut g = c.benchmark_group("ode_default_e_of_kappa");
+    g.measurement_time(Duration::from_secs(3));
+    for kappa in [1e-3, 0.1, 1.0, 5.0] {
+        for rule in ContactEnd::ALL {
+            g.bench_with_input(BenchmarkId::new(rule.name(), kappa), &kappa, |b, &k| {
+                b.iter(|| restitution_ode(black_box(k), rule, &OdeSettings::DEFAULT))
+            });
+        }
+    }
+    g.finish();
+}
+
+fn plastic(c: &mut Criterion) {
+    let mut g = c.benchmark_group("plastic_e_of_u");
+    for u in [1.001, 10.0, 1e6] {
+        g.bench_with_input(BenchmarkId::from_parameter(u), &u, |b, &u| {
+            b.iter(|| rebound_u(black_box(u)))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, master_curve, ode_default, plastic);
+criterion_main!(benches);
