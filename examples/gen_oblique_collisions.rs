@@ -8,7 +8,10 @@
 //! (default `data/oblique_collisions.csv`), `--truth` (write the noise-free kinematics instead).
 
 use restitution::data::write_atomic;
-use restitution::fit::walton::{SyntheticSpec, synthetic_collisions, write_collisions};
+use restitution::fit::walton::{
+    CollisionRecord, SyntheticSpec, synthetic_collisions, write_collisions,
+};
+use restitution::models::walton::{Body, Target};
 use std::path::PathBuf;
 
 fn main() {
@@ -38,8 +41,13 @@ fn main() {
             other => fail(&format!("unknown argument '{other}'")),
         }
     }
-    let (exact, measured) =
+    let (exact, mut measured) =
         synthetic_collisions(&spec, seed).unwrap_or_else(|e| fail(&e.to_string()));
+    // Measured numbers are written to a resolution far below their noise (0.1 mm/s, 1 mrad/s,
+    // 1 um), as an analysis program would print them.
+    for r in &mut measured {
+        round_record(r);
+    }
     let p = spec.params;
     let mut text = String::new();
     text += "# Synthetic oblique collisions of two 25.4 mm nylon spheres, like Labous, Rosato & Dave (1997) Fig. 6.\n";
@@ -58,7 +66,7 @@ fn main() {
         spec.d_m * 1e3
     );
     text += &format!(
-        "# True slope s = mu0 (1 + 1/K)(1 + e) = {}, kink psi* = (1 + beta0)/s = {}\n",
+        "# True slope s = mu0 (1 + 1/K)(1 + e) = {:.6}, kink psi* = (1 + beta0)/s = {:.6}\n",
         p.mu0 * (1.0 + 1.0 / spec.inertia_k) * (1.0 + p.e),
         (1.0 + p.beta0) / (p.mu0 * (1.0 + 1.0 / spec.inertia_k) * (1.0 + p.e))
     );
@@ -88,4 +96,34 @@ fn main() {
 fn fail(msg: &str) -> ! {
     eprintln!("gen_oblique_collisions: error: {msg}");
     std::process::exit(1);
+}
+
+fn round_record(r: &mut CollisionRecord) {
+    // Through decimal text, so that the shortest round-trip form prints the rounded digits only.
+    let round = |x: f64, decimals: usize| -> f64 {
+        format!("{x:.decimals$}")
+            .parse()
+            .expect("a formatted float parses")
+    };
+    let body = |b: &mut Body, position: bool| {
+        if position {
+            b.position_m = b.position_m.map(|x| round(x, 6));
+        }
+        b.velocity_m_s = b.velocity_m_s.map(|x| round(x, 4));
+        b.spin_rad_s = b.spin_rad_s.map(|x| round(x, 3));
+    };
+    body(&mut r.pre.sphere, true);
+    body(&mut r.post.sphere, false);
+    r.post.sphere.position_m = r.pre.sphere.position_m;
+    if let Target::Sphere(b) = &mut r.pre.target {
+        body(b, true);
+    }
+    let p2 = match r.pre.target {
+        Target::Sphere(b) => b.position_m,
+        Target::Wall { contact_point_m } => contact_point_m,
+    };
+    if let Target::Sphere(b) = &mut r.post.target {
+        body(b, false);
+        b.position_m = p2;
+    }
 }

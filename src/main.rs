@@ -18,6 +18,8 @@ struct Cli {
 enum Command {
     /// e(v) from the viscoelastic or plastic model
     Predict(cli::predict::Args),
+    /// Walton's collision operator: fit e, beta_0 and mu_0 to oblique collisions (Fig. 6)
+    Walton(cli::walton::Args),
 }
 
 fn main() -> ExitCode {
@@ -42,6 +44,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Predict(args) => cli::predict::run(args),
+        Command::Walton(args) => cli::walton::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -51,6 +51,9 @@ pub struct HingeFit {
     /// Gauss-Newton normal matrix (the two parameters act on disjoint points, so it is diagonal).
     pub info_slope: f64,
     pub info_beta0: f64,
+    /// The part of `sse` from the sliding points and from the rolling points.
+    pub sse_sliding: f64,
+    pub sse_rolling: f64,
 }
 
 impl HingeFit {
@@ -202,6 +205,8 @@ pub fn fit_hinge(psi: &[f64], beta: &[f64], weight: &[f64]) -> Result<HingeFit> 
         n_rolling: 0,
         info_slope: 0.0,
         info_beta0: 0.0,
+        sse_sliding: 0.0,
+        sse_rolling: 0.0,
     };
     // The reported SSE is summed directly (the prefix-sum form cancels when the fit is close).
     for i in 0..n {
@@ -215,9 +220,11 @@ pub fn fit_hinge(psi: &[f64], beta: &[f64], weight: &[f64]) -> Result<HingeFit> 
         if on_line {
             fit.n_sliding += 1;
             fit.info_slope += weight[i] * psi[i] * psi[i];
+            fit.sse_sliding += weight[i] * r * r;
         } else {
             fit.n_rolling += 1;
             fit.info_beta0 += weight[i];
+            fit.sse_rolling += weight[i] * r * r;
         }
     }
     Ok(fit)
@@ -395,9 +402,11 @@ fn percentile_interval(v: &mut [f64]) -> Option<(f64, f64)> {
 ///
 /// e is the weighted mean of the e_i; the hinge beta(psi) = min(-1 + s psi, beta_0) is fitted
 /// globally by [`fit_hinge`] to the collisions that have a beta (not head-on);
-/// mu_0 = s/((1 + 1/K)(1 + e)) (Eq. 7). Standard errors: var(s) = sigma^2/sum_sliding w psi^2,
-/// var(beta_0) = sigma^2/sum_rolling w, sigma^2 = SSE/(n - 2), valid for a kink strictly between
-/// data points; mu_0's adds the error of e in quadrature (delta method). The 95% intervals are
+/// mu_0 = s/((1 + 1/K)(1 + e)) (Eq. 7). Standard errors: var(s) = sigma_sl^2/sum_sliding w psi^2,
+/// var(beta_0) = sigma_rol^2/sum_rolling w, with sigma_sl^2 and sigma_rol^2 the weighted residual
+/// variances of the two branches (the Gauss-Newton covariance, which is diagonal because s and
+/// beta_0 act on disjoint points; valid for a kink strictly between data points); mu_0's adds
+/// the error of e in quadrature (delta method). The 95% intervals are
 /// percentile intervals of a pairs bootstrap (collisions resampled with replacement, the whole
 /// fit redone; seeded, so reproducible), which needs no assumption about the error distribution
 /// and carries the kink's nonlinearity and e's correlation into mu_0.
@@ -464,12 +473,17 @@ pub fn fit(measured: &[Measured], options: &FitOptions) -> Result<WaltonFit> {
 
     // Hinge parameters and their standard errors.
     let dof = psi.len() - 2;
-    let sigma2 = hinge.sse / dof as f64;
+    // Each parameter acts on its own points only, so each branch's residual variance scales its
+    // parameter's error: the sliding points carry the extra scatter of psi (errors in the
+    // abscissa times the slope), the plateau does not. With fewer than 2 points on a branch,
+    // the pooled variance is used.
+    let pooled = hinge.sse / dof as f64;
+    let branch = |sse: f64, m: usize| if m >= 2 { sse / (m - 1) as f64 } else { pooled };
     let both = hinge.shape == HingeShape::Both;
     let slope_se = (hinge.shape != HingeShape::NoSliding && hinge.info_slope > 0.0)
-        .then(|| (sigma2 / hinge.info_slope).sqrt());
+        .then(|| (branch(hinge.sse_sliding, hinge.n_sliding) / hinge.info_slope).sqrt());
     let beta0_se = (hinge.shape != HingeShape::NoRolling && hinge.info_beta0 > 0.0)
-        .then(|| (sigma2 / hinge.info_beta0).sqrt());
+        .then(|| (branch(hinge.sse_rolling, hinge.n_rolling) / hinge.info_beta0).sqrt());
     let mu0 = hinge.slope / (factor * (1.0 + e_mean));
     let mu0_se = slope_se
         .map(|se| mu0 * ((se / hinge.slope).powi(2) + (e_stderr / (1.0 + e_mean)).powi(2)).sqrt());
@@ -1091,13 +1105,18 @@ pub fn write_collisions(records: &[CollisionRecord]) -> String {
     }
     header.push("d1_mm".into());
     header.push("d2_mm".into());
-    // Positions of both spheres first, then sphere 1's and sphere 2's motion.
-    for &j in cols.iter().filter(|&&j| j < 3) {
-        header.push(c1[j].clone());
-        header.push(c2[j].clone());
-    }
-    for c in [&c1, &c2] {
-        for &j in cols.iter().filter(|&&j| j >= 3) {
+    // The order: positions (sphere 1, sphere 2), motion before (1, 2), after (1, 2).
+    let groups: [(bool, std::ops::Range<usize>); 6] = [
+        (true, 0..3),
+        (false, 0..3),
+        (true, 3..9),
+        (false, 3..9),
+        (true, 9..15),
+        (false, 9..15),
+    ];
+    for (first, range) in &groups {
+        let c = if *first { &c1 } else { &c2 };
+        for &j in cols.iter().filter(|j| range.contains(j)) {
             header.push(c[j].clone());
         }
     }
@@ -1113,12 +1132,9 @@ pub fn write_collisions(records: &[CollisionRecord]) -> String {
         } else {
             fmt_num(d2 * 1e3)
         });
-        for &j in cols.iter().filter(|&&j| j < 3) {
-            cells.push(fmt_num(a[j]));
-            cells.push(fmt_num(b[j]));
-        }
-        for v in [a, b] {
-            for &j in cols.iter().filter(|&&j| j >= 3) {
+        for (first, range) in &groups {
+            let v = if *first { a } else { b };
+            for &j in cols.iter().filter(|j| range.contains(j)) {
                 cells.push(fmt_num(v[j]));
             }
         }
