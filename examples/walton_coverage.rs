@@ -27,7 +27,9 @@ fn main() {
         "weights  param   mean      sd(fit)   mean stderr  coverage(ci95)  coverage(+-1.96 se)  not converged"
     );
     for weights in [Weights::Camera, Weights::Equal] {
-        let mut rows: Vec<(&str, f64, Vec<f64>, Vec<f64>, usize, usize)> = vec![
+        // name, truth, estimates, stderrs, covered by ci95, covered by +-1.96 stderr
+        type Row = (&'static str, f64, Vec<f64>, Vec<f64>, usize, usize);
+        let mut rows: Vec<Row> = vec![
             ("beta0", truth.beta0, vec![], vec![], 0, 0),
             ("mu0", truth.mu0, vec![], vec![], 0, 0),
             ("e", truth.e, vec![], vec![], 0, 0),

@@ -153,7 +153,8 @@ fn run_fit(a: FitArgs) -> CliResult {
         lines: records.iter().map(|r| r.line).collect(),
         ids: records.iter().map(|r| r.id.clone()).collect(),
         material,
-        command: std::env::args()
+        command: std::iter::once("restitution".to_string())
+            .chain(std::env::args().skip(1))
             .map(|s| if s.contains(' ') { format!("'{s}'") } else { s })
             .collect::<Vec<_>>()
             .join(" "),

@@ -582,12 +582,11 @@ pub fn fit(measured: &[Measured], options: &FitOptions) -> Result<WaltonFit> {
             },
             Some(b) => Classified {
                 measured: *m,
-                kind: Some(if both && m.psi < hinge.kink_psi {
-                    ContactKind::Sliding
-                } else if hinge.shape == HingeShape::NoRolling {
-                    ContactKind::Sliding
-                } else {
-                    ContactKind::Rolling
+                kind: Some(match hinge.shape {
+                    HingeShape::NoRolling => ContactKind::Sliding,
+                    HingeShape::NoSliding => ContactKind::Rolling,
+                    HingeShape::Both if m.psi < hinge.kink_psi => ContactKind::Sliding,
+                    HingeShape::Both => ContactKind::Rolling,
                 }),
                 residual: Some(b - hinge.beta_at(m.psi)),
             },
@@ -1003,7 +1002,8 @@ pub fn read_collisions(
             Target::Wall { contact_point_m } => contact_point_m,
         };
         let dist = (pre.sphere.position_m - other).norm();
-        if !((dist / touching - 1.0).abs() <= CONTACT_DISTANCE_TOLERANCE) {
+        let off = (dist / touching - 1.0).abs();
+        if off.is_nan() || off > CONTACT_DISTANCE_TOLERANCE {
             let what = if wall {
                 "centre to wall contact point (x2_m, y2_m) is"
             } else {
@@ -1047,7 +1047,7 @@ pub fn measure_records(
             };
             let frame = r.pre.contact().map_err(|e| err(e.to_string()))?;
             let approach = frame.v_rel_m_s.dot(&frame.normal);
-            if !(approach < 0.0) {
+            if approach.is_nan() || approach >= 0.0 {
                 return Err(err(format!(
                     "the spheres are not approaching before the collision: (v1 - v2) . n = {} m/s, expected < 0 (n points from sphere 2 to sphere 1; check the velocity signs and the pre/post columns)",
                     fmt_num(approach)

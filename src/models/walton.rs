@@ -490,7 +490,7 @@ pub fn measure(pre: &State, post: &State) -> Result<Measured> {
         }
     };
     let approach = f.v_rel_m_s.dot(&n);
-    if !(approach < 0.0) {
+    if approach.is_nan() || approach >= 0.0 {
         return Err(Error::InvalidParameter {
             name: "normal relative velocity (v_1 - v_2) . n before the collision (m/s)",
             value: approach,
