@@ -110,9 +110,11 @@ fn angular_scale(s: &State, about: &Vector3<f64>, impulse: f64) -> f64 {
     bodies(s)
         .iter()
         .map(|b| {
-            b.mass_kg * (b.position_m - about).norm() * b.velocity_m_s.norm()
+            // r - about carries the absolute rounding of the positions themselves.
+            let lever = (b.position_m - about).norm() + b.position_m.norm() + about.norm();
+            b.mass_kg * lever * b.velocity_m_s.norm()
                 + b.inertia_kg_m2() * b.spin_rad_s.norm()
-                + impulse * ((b.position_m - about).norm() + b.d_m)
+                + impulse * (lever + b.d_m)
         })
         .sum()
 }
