@@ -342,7 +342,7 @@ fn fit_recovers_planted_parameters_within_its_intervals() {
             }
         }
     }
-    // Measured coverage at n = 60 is 93-94% (examples/walton_coverage.rs, 1000 repetitions).
+    // Measured coverage at n = 60 is 92.5-93.6% (examples/walton_coverage.rs, 1000 repetitions).
     // With 100 repetitions the count has sd ~2.5, so [85, 100) fails a correct 93% interval
     // with probability < 0.1% while catching intervals that are too narrow (a 1-sigma
     // interval would cover ~68) or degenerate. The seeds are fixed, so the test is repeatable.

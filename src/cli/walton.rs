@@ -55,9 +55,23 @@ enum WeightsArg {
     Equal,
 }
 
+const COLUMNS: &str = "\
+COLLISIONS.csv: a header line, then one collision per row; columns in any order; lines starting
+with # and blank lines are skipped (error messages still give the file's own line numbers).
+  required   d1_mm, d2_mm                      diameters; d2_mm = inf: a flat wall at rest
+             x1_m, y1_m, x2_m, y2_m            centres at contact (wall: x2_m, y2_m = contact point)
+             v1x_m_s, v1y_m_s, w1z_rad_s       sphere 1 before; likewise v2x_m_s, v2y_m_s, w2z_rad_s
+             v1x_post_m_s, v1y_post_m_s, w1z_post_rad_s, and the same for sphere 2: after
+             (a wall's velocity and spin columns may be absent, empty or 0)
+  optional   z1_m, z2_m, v1z_m_s, w1x_rad_s, w1y_rad_s, ... and their _post forms: 3-D (0 if absent)
+             collision                         an id carried to the outputs
+Conventions: n = (r1 - r2)/|r1 - r2|; psi = -v_n/|v_s| with v_c = v1 - v2 - (d1/2 w1 + d2/2 w2) x n.
+Example: restitution walton fit data/oblique_collisions.csv --material nylon --out reports/walton";
+
 #[derive(clap::Args, Debug)]
+#[command(after_long_help = COLUMNS)]
 struct FitArgs {
-    /// CSV of measured pre- and post-collision kinematics (columns: see `restitution walton fit --help`)
+    /// CSV of measured pre- and post-collision kinematics (columns: see --help)
     #[arg(value_name = "COLLISIONS.csv")]
     path: PathBuf,
     #[command(flatten)]

@@ -475,10 +475,10 @@ pub fn fit(measured: &[Measured], options: &FitOptions) -> Result<WaltonFit> {
     let dof = psi.len() - 2;
     // Each parameter acts on its own points only, so each branch's residual variance scales its
     // parameter's error: the sliding points carry the extra scatter of psi (errors in the
-    // abscissa times the slope), the plateau does not. With fewer than 2 points on a branch,
-    // the pooled variance is used.
+    // abscissa times the slope), the plateau does not. A branch of fewer than 5 points gives too
+    // unsteady a variance (under 4 degrees of freedom); the pooled one is used instead.
     let pooled = hinge.sse / dof as f64;
-    let branch = |sse: f64, m: usize| if m >= 2 { sse / (m - 1) as f64 } else { pooled };
+    let branch = |sse: f64, m: usize| if m >= 5 { sse / (m - 1) as f64 } else { pooled };
     let both = hinge.shape == HingeShape::Both;
     let slope_se = (hinge.shape != HingeShape::NoSliding && hinge.info_slope > 0.0)
         .then(|| (branch(hinge.sse_sliding, hinge.n_sliding) / hinge.info_slope).sqrt());
@@ -628,12 +628,30 @@ pub fn fit(measured: &[Measured], options: &FitOptions) -> Result<WaltonFit> {
         (r.iter().map(|x| x * x).sum::<f64>() / r.len() as f64).sqrt()
     };
 
-    let message = match hinge.shape {
-        HingeShape::Both if failed * 100 > options.bootstrap => format!(
-            "converged; {failed} of {} bootstrap resamples had no collisions on one side of the kink and were left out of the intervals, which may therefore be too narrow",
+    let thin = |m: usize, what: &str, param: &str| {
+        (m < 3).then(|| {
+            format!(
+                "; only {m} collision(s) on the {what}, so {param} rests on them: the bootstrap interval is the more honest error"
+            )
+        })
+    };
+    let thin_note = [
+        thin(hinge.n_sliding, "sliding line", "mu0"),
+        thin(hinge.n_rolling, "rolling plateau", "beta0"),
+    ]
+    .into_iter()
+    .flatten()
+    .collect::<String>();
+    let failed_note = if failed * 100 > options.bootstrap {
+        format!(
+            "; {failed} of {} bootstrap resamples had no collisions on one side of the kink and were left out of the intervals, which may therefore be too narrow",
             options.bootstrap
-        ),
-        HingeShape::Both => "converged".to_string(),
+        )
+    } else {
+        String::new()
+    };
+    let message = match hinge.shape {
+        HingeShape::Both => format!("converged{thin_note}{failed_note}"),
         HingeShape::NoRolling => format!(
             "not determined: no collision reached the rolling plateau, so beta0 >= {} is only a lower bound (mu0 is determined); add collisions closer to head-on (larger psi)",
             fmt_num(hinge.beta0)
