@@ -2,6 +2,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
+use restitution::contact::{Material, Sphere};
 use restitution::fit::walton::{
     FitOptions, SyntheticSpec, fit, measure_records, synthetic_collisions,
 };
@@ -11,9 +12,10 @@ use std::hint::black_box;
 fn bench(c: &mut Criterion) {
     let d = 0.0254;
     let n = Vector3::new(0.6, 0.8, 0.0);
-    let b1 = Body::homogeneous(0.5 * d * n, d, 1140.0)
+    let nylon = Sphere::new(d, Material::preset("nylon").unwrap()).unwrap();
+    let b1 = Body::homogeneous(0.5 * d * n, &nylon)
         .moving(Vector3::new(-1.9, 0.4, 0.1), Vector3::new(0.0, 1.0, 5.0));
-    let b2 = Body::homogeneous(-0.5 * d * n, d, 1140.0)
+    let b2 = Body::homogeneous(-0.5 * d * n, &nylon)
         .moving(Vector3::new(2.0, -0.1, 0.0), Vector3::new(2.0, 0.0, -3.0));
     let pre = State::pair(b1, b2);
     let p = WaltonParams::PAPER_NYLON;

@@ -62,7 +62,7 @@ fn main() {
         p.mu0,
         p.beta0,
         spec.inertia_k,
-        spec.density_kg_m3,
+        spec.material.density_kg_m3,
         spec.d_m * 1e3
     );
     text += &format!(

@@ -2,6 +2,7 @@
 
 use nalgebra::Vector3;
 use proptest::prelude::*;
+use restitution::contact::{Material, Sphere};
 use restitution::data::Table;
 use restitution::fit::walton::{
     CollisionRecord, FitOptions, SyntheticSpec, Weights, fit, measure_records, read_collisions,
@@ -14,6 +15,12 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 const EPS: f64 = f64::EPSILON;
+
+/// A homogeneous sphere of diameter `d_m` and density `rho` (the elastic constants do not enter
+/// Walton's operator).
+fn sphere(d_m: f64, rho: f64) -> Sphere {
+    Sphere::new(d_m, Material::new(1e9, 0.3, rho).unwrap()).unwrap()
+}
 
 // ---------------------------------------------------------------------------------------------
 // Random states.
@@ -39,7 +46,7 @@ fn body() -> impl Strategy<Value = Body> {
         vec3(300.0),
     )
         .prop_map(|(d, rho, k, v, w)| {
-            let mut b = Body::homogeneous(Vector3::zeros(), d, rho).moving(v, w);
+            let mut b = Body::homogeneous(Vector3::zeros(), &sphere(d, rho)).moving(v, w);
             b.inertia_k = k;
             b
         })
@@ -244,9 +251,9 @@ proptest! {
 #[test]
 fn rolling_branch_returns_beta0() {
     let d = 0.0254;
-    let b1 = Body::homogeneous(Vector3::new(0.0, 0.0, 0.0), d, 1140.0)
+    let b1 = Body::homogeneous(Vector3::new(0.0, 0.0, 0.0), &sphere(d, 1140.0))
         .moving(Vector3::new(-2.0, 0.3, 0.0), Vector3::new(0.0, 0.0, 5.0));
-    let b2 = Body::homogeneous(Vector3::new(-d, 0.0, 0.0), d, 1140.0)
+    let b2 = Body::homogeneous(Vector3::new(-d, 0.0, 0.0), &sphere(d, 1140.0))
         .moving(Vector3::new(2.0, -0.2, 0.0), Vector3::zeros());
     let pre = State::pair(b1, b2);
     let post = collide(&pre, &WaltonParams::PAPER_NYLON).unwrap();
@@ -264,9 +271,9 @@ fn rolling_branch_returns_beta0() {
 #[test]
 fn head_on_collision_has_no_beta() {
     let d = 0.0254;
-    let b1 = Body::homogeneous(Vector3::zeros(), d, 1140.0)
+    let b1 = Body::homogeneous(Vector3::zeros(), &sphere(d, 1140.0))
         .moving(Vector3::new(-1.0, 0.0, 0.0), Vector3::zeros());
-    let b2 = Body::homogeneous(Vector3::new(-d, 0.0, 0.0), d, 1140.0)
+    let b2 = Body::homogeneous(Vector3::new(-d, 0.0, 0.0), &sphere(d, 1140.0))
         .moving(Vector3::new(1.0, 0.0, 0.0), Vector3::zeros());
     let pre = State::pair(b1, b2);
     let post = collide(&pre, &WaltonParams::PAPER_NYLON).unwrap();
@@ -423,7 +430,9 @@ fn camera_weights_beat_equal_weights_on_paper_like_data() {
 
 fn parse(text: &str) -> Vec<CollisionRecord> {
     let t = Table::parse("t.csv", text).unwrap();
-    read_collisions(&t, 1140.0, K_HOMOGENEOUS).unwrap().0
+    read_collisions(&t, &Material::preset("nylon").unwrap(), K_HOMOGENEOUS)
+        .unwrap()
+        .0
 }
 
 #[test]
@@ -433,12 +442,12 @@ fn written_collisions_read_back_identically() {
     for i in 0..4 {
         let x = i as f64;
         let n = Vector3::new(1.0, 0.3 * x, -0.2).normalize();
-        let b1 = Body::homogeneous(0.5 * 0.02 * n, 0.02, 1140.0).moving(
+        let b1 = Body::homogeneous(0.5 * 0.02 * n, &sphere(0.02, 1140.0)).moving(
             Vector3::new(-1.0, 0.1 * x, 0.3),
             Vector3::new(1.0, -2.0, 3.0 + x),
         );
         let pre = if i % 2 == 0 {
-            let b2 = Body::homogeneous(-0.5 * 0.01 * n, 0.01, 1140.0)
+            let b2 = Body::homogeneous(-0.5 * 0.01 * n, &sphere(0.01, 1140.0))
                 .moving(Vector3::new(0.5, 0.0, -0.1), Vector3::new(0.0, 4.0, -1.0));
             State::pair(b1, b2)
         } else {
@@ -778,7 +787,8 @@ fn three_d_and_wall_collisions_fit_end_to_end() {
         let n = Vector3::new(0.1, 0.2, 1.0).normalize();
         let t = n.cross(&Vector3::new(1.0, 0.0, 0.0)).normalize();
         let v = -2.0 * (theta.cos() * n) + 2.0 * theta.sin() * t;
-        let b = Body::homogeneous(0.005 * n, 0.01, 7850.0).moving(v, Vector3::new(3.0, -1.0, 2.0));
+        let b = Body::homogeneous(0.005 * n, &sphere(0.01, 7850.0))
+            .moving(v, Vector3::new(3.0, -1.0, 2.0));
         let pre = State::on_wall(b, Vector3::zeros());
         let post = collide(&pre, &p).unwrap().state;
         records.push(CollisionRecord {

@@ -125,7 +125,7 @@ fn run_fit(a: FitArgs) -> CliResult {
     let material = a.material.resolve()?;
     let table = Table::read(&a.path).map_err(|e| e.to_string())?;
     let (records, warnings) =
-        read_collisions(&table, material.density_kg_m3, a.inertia_k).map_err(|e| e.to_string())?;
+        read_collisions(&table, &material, a.inertia_k).map_err(|e| e.to_string())?;
     for w in &warnings {
         eprintln!("restitution: warning: {w}");
     }

@@ -11,6 +11,7 @@
 //! so that every producer of oblique-collision data (the generator, the kinematics command) writes
 //! exactly what the fit reads.
 
+use crate::contact::{Material, Sphere};
 use crate::data::{DataError, Table, fmt_num};
 use crate::error::{Error, Result};
 use crate::models::walton::{self, Body, ContactKind, Measured, State, Target};
@@ -707,7 +708,7 @@ impl WaltonFit {
 pub struct SyntheticSpec {
     pub n: usize,
     pub d_m: f64,
-    pub density_kg_m3: f64,
+    pub material: Material,
     pub inertia_k: f64,
     pub params: walton::WaltonParams,
     /// Mean launch speed of each sphere and its standard deviation, m/s.
@@ -736,7 +737,7 @@ impl SyntheticSpec {
         SyntheticSpec {
             n: 60,
             d_m: 0.0254,
-            density_kg_m3: 1140.0,
+            material: Material::preset("nylon").expect("a preset"),
             inertia_k: walton::K_HOMOGENEOUS,
             params: walton::WaltonParams::PAPER_NYLON,
             speed_m_s: 2.0,
@@ -771,6 +772,7 @@ pub fn synthetic_collisions(
         normal(spec.noise_w_rad_s)?,
         normal(spec.noise_r_m)?,
     );
+    let sphere = Sphere::new(spec.d_m, spec.material)?;
     let mut rng = StdRng::seed_from_u64(seed);
     let mut truth = Vec::with_capacity(spec.n);
     let mut measured = Vec::with_capacity(spec.n);
@@ -799,12 +801,8 @@ pub fn synthetic_collisions(
         );
         let r2 = r1 - spec.d_m * n;
         let body = |r: Vector3<f64>, v: Vector3<f64>, w: f64| Body {
-            position_m: r,
-            velocity_m_s: v,
-            spin_rad_s: Vector3::new(0.0, 0.0, w),
-            d_m: spec.d_m,
-            mass_kg: std::f64::consts::PI / 6.0 * spec.d_m.powi(3) * spec.density_kg_m3,
             inertia_k: spec.inertia_k,
+            ..Body::homogeneous(r, &sphere).moving(v, Vector3::new(0.0, 0.0, w))
         };
         let pre = State::pair(
             body(r1, v1, spin0.sample(&mut rng)),
@@ -898,12 +896,12 @@ const REQUIRED: [usize; 8] = [0, 1, 3, 4, 8, 9, 10, 14];
 const CONTACT_DISTANCE_TOLERANCE: f64 = 0.25;
 
 /// Reads the collisions of a `walton fit` CSV (schema in the module doc of `cli::walton`).
-/// Masses come from the diameters and `density_kg_m3`; both spheres get inertia factor
+/// Masses come from the diameters and `material` ([`Sphere::mass_kg`]); both spheres get inertia factor
 /// `inertia_k`. Returns the records and warnings (unknown columns, 3-D columns without their
 /// pre/post partner). Errors name the file, line, column and value.
 pub fn read_collisions(
     table: &Table,
-    density_kg_m3: f64,
+    material: &Material,
     inertia_k: f64,
 ) -> std::result::Result<(Vec<CollisionRecord>, Vec<String>), DataError> {
     let d1c = table.require("d1_mm")?;
@@ -988,7 +986,12 @@ pub fn read_collisions(
         }
         let vec3 = |v: &[f64; 15], j: usize| Vector3::new(v[j], v[j + 1], v[j + 2]);
         let d1 = d1_mm * 1e-3;
-        let mass = |d: f64| std::f64::consts::PI / 6.0 * d.powi(3) * density_kg_m3;
+        // Diameters were checked > 0 above, so the sphere is valid.
+        let mass = |d: f64| {
+            Sphere::new(d, *material)
+                .map(|s| s.mass_kg())
+                .unwrap_or(f64::NAN)
+        };
         let body = |v: &[f64; 15], d: f64, post: bool| Body {
             position_m: vec3(v, 0),
             velocity_m_s: vec3(v, if post { 9 } else { 3 }),

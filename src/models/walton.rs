@@ -15,13 +15,15 @@
 //! n = (r_1 - r_2)/|r_1 - r_2| points from sphere 2 to sphere 1; the contact velocity is
 //! v_c = v_1 - v_2 - (d_1/2 w_1 + d_2/2 w_2) x n (Eq. 3); approaching spheres have v_c . n < 0.
 //!
-//! Generalisation beyond the paper (re-derived in PHYSICS.md §4 and checked by the tests): each
+//! Generalisation beyond the paper and PHYSICS.md §4 (derived here; the tests check momentum,
+//! angular momentum and the energy loss for unequal K): each
 //! body carries its own inertia factor K_i = 4 I_i/(m_i d_i^2). A tangential impulse changes the
 //! contact velocity by Delta v_s = Delta P_t / m_t with the tangential effective mass
 //! 1/m_t = (1 + 1/K_1)/m_1 + (1 + 1/K_2)/m_2 (a wall contributes nothing). With K_1 = K_2 = K this
 //! is m_t = m_red K/(1 + K) and every formula below reduces to the paper's; the sliding-branch
 //! slope mu_0 (1 + 1/K)(1 + e) of Eq. (7) becomes mu_0 (1 + e) m_red/m_t.
 
+use crate::contact::Sphere;
 use crate::error::{Error, Result};
 use nalgebra::Vector3;
 
@@ -46,15 +48,15 @@ pub struct Body {
 }
 
 impl Body {
-    /// A homogeneous sphere (K = 2/5) of diameter `d_m` and density `density_kg_m3`, at rest and
-    /// not spinning, centred at `position_m`.
-    pub fn homogeneous(position_m: Vector3<f64>, d_m: f64, density_kg_m3: f64) -> Self {
+    /// A homogeneous sphere (K = 2/5, mass from [`Sphere::mass_kg`]) at rest and not spinning,
+    /// centred at `position_m`.
+    pub fn homogeneous(position_m: Vector3<f64>, sphere: &Sphere) -> Self {
         Body {
             position_m,
             velocity_m_s: Vector3::zeros(),
             spin_rad_s: Vector3::zeros(),
-            d_m,
-            mass_kg: std::f64::consts::PI / 6.0 * d_m.powi(3) * density_kg_m3,
+            d_m: sphere.d_m,
+            mass_kg: sphere.mass_kg(),
             inertia_k: K_HOMOGENEOUS,
         }
     }
@@ -550,7 +552,8 @@ mod tests {
     fn sphere_on_wall_known_answers() {
         let d = 0.02;
         let r = 0.5 * d;
-        let body = Body::homogeneous(Vector3::new(0.0, r, 0.0), d, 1140.0)
+        let nylon = Sphere::new(d, crate::contact::Material::preset("nylon").unwrap()).unwrap();
+        let body = Body::homogeneous(Vector3::new(0.0, r, 0.0), &nylon)
             .moving(Vector3::new(1.5, -2.0, 0.0), Vector3::zeros());
         let pre = State::on_wall(body, Vector3::zeros());
         // Sliding: psi = 2/1.5, slope mu (1 + 1/K)(1 + e) = 0.1 * 3.5 * 1.9 -> beta = -0.1133 < 0.9.
@@ -573,7 +576,8 @@ mod tests {
 
     #[test]
     fn rejects_receding_and_bad_params() {
-        let b1 = Body::homogeneous(Vector3::new(0.0, 0.01, 0.0), 0.02, 1000.0)
+        let s = Sphere::new(0.02, crate::contact::Material::preset("nylon").unwrap()).unwrap();
+        let b1 = Body::homogeneous(Vector3::new(0.0, 0.01, 0.0), &s)
             .moving(Vector3::new(0.0, 1.0, 0.0), Vector3::zeros());
         let pre = State::on_wall(b1, Vector3::zeros());
         let p = WaltonParams::PAPER_NYLON;
