@@ -895,7 +895,7 @@ const REQUIRED: [usize; 8] = [0, 1, 3, 4, 8, 9, 10, 14];
 /// is a few per cent of a diameter in the paper's images).
 const CONTACT_DISTANCE_TOLERANCE: f64 = 0.25;
 
-/// Reads the collisions of a `walton fit` CSV (schema in the module doc of `cli::walton`).
+/// Reads the collisions of a `walton fit` CSV (schema: `restitution walton fit --help`).
 /// Masses come from the diameters and `material` ([`Sphere::mass_kg`]); both spheres get inertia factor
 /// `inertia_k`. Returns the records and warnings (unknown columns, 3-D columns without their
 /// pre/post partner). Errors name the file, line, column and value.
