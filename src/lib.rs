@@ -4,6 +4,7 @@
 pub mod contact;
 pub mod data;
 pub mod error;
+pub mod experiment;
 pub mod kinematics;
 pub mod models;
 pub mod plot;
