@@ -80,11 +80,9 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
         let mut spins = [f64::NAN; 4];
         let mut have_spins = false;
         for (k, c) in spin_cols.iter().enumerate() {
-            if let Some(c) = *c {
-                if !row.fields[c].is_empty() {
-                    spins[k] = table.number(row, c)?;
-                    have_spins = true;
-                }
+            if let Some(c) = c.filter(|&c| !row.fields[c].is_empty()) {
+                spins[k] = table.number(row, c)?;
+                have_spins = true;
             }
         }
         let i = match accs.iter().position(|a| a.track.id == id) {
