@@ -58,15 +58,16 @@ fn main() {
             for (row, (v, se, ci)) in rows.iter_mut().zip(est) {
                 row.2.push(v);
                 row.3.push(se.unwrap_or(f64::NAN));
-                if let Some((lo, hi)) = ci {
-                    if lo <= row.1 && row.1 <= hi {
-                        row.4 += 1;
-                    }
+                if let Some((lo, hi)) = ci
+                    && lo <= row.1
+                    && row.1 <= hi
+                {
+                    row.4 += 1;
                 }
-                if let Some(se) = se {
-                    if (v - row.1).abs() <= 1.96 * se {
-                        row.5 += 1;
-                    }
+                if let Some(se) = se
+                    && (v - row.1).abs() <= 1.96 * se
+                {
+                    row.5 += 1;
                 }
             }
         }

@@ -4,7 +4,9 @@
 pub mod contact;
 pub mod data;
 pub mod error;
+pub mod experiment;
 pub mod fit;
+pub mod kinematics;
 pub mod models;
 pub mod plot;
 
