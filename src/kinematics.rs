@@ -78,7 +78,7 @@ impl PolyFit {
         let c2 = fixed_c2.unwrap_or(0.0);
         let rhs = DVector::from_fn(n, |i, _| y[i] - c2 * (t[i] - t_ref).powi(2));
         let xtx = x.transpose() * &x;
-        let xtx_inv = xtx.try_inverse().ok_or_else(|| Error::InvalidParameter {
+        let xtx_inv = xtx.try_inverse().ok_or(Error::InvalidParameter {
             name: "frame times",
             value: t_ref,
             expected: "distinct times in each phase",

@@ -5,6 +5,8 @@ pub mod bench;
 pub mod contact;
 pub mod data;
 pub mod error;
+pub mod experiment;
+pub mod fit;
 pub mod kinematics;
 pub mod models;
 pub mod plot;

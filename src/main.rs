@@ -20,6 +20,8 @@ enum Command {
     Predict(cli::predict::Args),
     /// Speed against accuracy: work-precision chart and stability map of every method
     Bench(cli::bench::Args),
+    /// Walton's collision operator: fit e, beta_0 and mu_0 to oblique collisions (Fig. 6)
+    Walton(cli::walton::Args),
 }
 
 fn main() -> ExitCode {
@@ -45,6 +47,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Predict(args) => cli::predict::run(args),
         Command::Bench(args) => cli::bench::run(args),
+        Command::Walton(args) => cli::walton::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -5,3 +5,4 @@
 //! the rendered figures, not by the nominal point size.
 
 pub mod bench;
+pub mod walton;
