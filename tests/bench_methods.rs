@@ -371,3 +371,62 @@ fn csv_outputs_have_the_required_columns() {
         assert!(f.parse::<f64>().is_ok(), "{f}");
     }
 }
+
+#[test]
+fn cli_quick_run_writes_every_file_or_none() {
+    // The documented command at --quick (about a second on the dev box): all six files appear,
+    // with the columns the issue asks for; a bad --out is one line on stderr, exit 1, no files.
+    let dir = std::env::temp_dir().join(format!("restitution-bench-test-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_restitution"))
+        .args(["bench", "--quick", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "work_precision.csv",
+        "work_precision_points.csv",
+        "work_precision.svg",
+        "stability.csv",
+        "stability.svg",
+        "summary.md",
+    ] {
+        let text = std::fs::read_to_string(dir.join(f)).unwrap();
+        assert!(text.len() > 100, "{f}");
+    }
+    let wp = std::fs::read_to_string(dir.join("work_precision.csv")).unwrap();
+    let header: Vec<&str> = wp.lines().next().unwrap().split(',').collect();
+    for col in [
+        "model",
+        "method",
+        "setting",
+        "error",
+        "ns_per_eval",
+        "rhs_evals",
+    ] {
+        assert!(header.contains(&col), "{col}");
+    }
+    let st = std::fs::read_to_string(dir.join("stability.csv")).unwrap();
+    assert!(st.lines().any(|l| l.contains(",max_steps,")));
+    let _ = std::fs::remove_dir_all(&dir);
+
+    let blocker =
+        std::env::temp_dir().join(format!("restitution-bench-file-{}", std::process::id()));
+    std::fs::write(&blocker, "not a directory").unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_restitution"))
+        .args(["bench", "--quick", "--out"])
+        .arg(&blocker)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.starts_with("restitution: error: --out"), "{err}");
+    assert!(out.stdout.is_empty());
+    let _ = std::fs::remove_file(&blocker);
+}
