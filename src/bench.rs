@@ -286,7 +286,7 @@ pub fn run(cfg: &BenchConfig) -> Result<BenchReport> {
     cells.extend(stability::pm_map(&pm_map_specs(), &pm_refs));
 
     let reference_check = reference::check_ode_reference()?;
-    let candidates = ode_candidates(cfg, &kappas, &vm_refs, &plan)?;
+    let candidates = ode_candidates(&kappas, &vm_refs, &plan)?;
     Ok(BenchReport {
         config: *cfg,
         rows,
@@ -301,7 +301,6 @@ pub fn run(cfg: &BenchConfig) -> Result<BenchReport> {
 /// Cheaper settings than the default, each checked against the bar for the default over
 /// the fixture and the dense kappa grid up to 100, both rules.
 pub fn ode_candidates(
-    cfg: &BenchConfig,
     kappas: &[f64],
     chart_refs: &[VmRef],
     plan: &TimingPlan,
@@ -313,7 +312,6 @@ pub fn ode_candidates(
             tol,
         )));
     }
-    let _ = cfg;
     let mut dense: Vec<VmRef> = Vec::new();
     for rule in ContactEnd::ALL {
         for &kappa in kappas.iter().filter(|&&k| k <= 100.0) {

@@ -326,14 +326,21 @@ pub fn work_precision_svg(report: &BenchReport) -> Result<String, String> {
             )
             .map_err(err_str)?;
         }
-        // Slope-4 guide through the geometric middle of the data.
-        if let (Some(first), Some(last)) = (rk4.first(), rk4.last()) {
-            let _ = (first, last);
-            let h_mid = (x_d.0 * x_d.1).sqrt();
-            let e_mid = (y_d.0 * y_d.1).sqrt();
-            let guide: Vec<(f64, f64)> = [x_d.0 * 1.5, x_d.1 / 1.5]
-                .iter()
-                .map(|&h| (h, e_mid * (h / h_mid).powi(4)))
+        // Slope-4 guide: through the overlap-rule point nearest the middle step, 3x above it.
+        let h_mid = (x_d.0 * x_d.1).sqrt();
+        let anchor = rk4
+            .iter()
+            .filter(|r| r.rule == "overlap" && r.error > 0.0)
+            .min_by(|a, b| {
+                (a.knob / h_mid)
+                    .ln()
+                    .abs()
+                    .total_cmp(&(b.knob / h_mid).ln().abs())
+            });
+        if let Some(a) = anchor {
+            let guide: Vec<(f64, f64)> = (0..=20)
+                .map(|i| x_d.0 * (x_d.1 / x_d.0).powf(i as f64 / 20.0))
+                .map(|h| (h, 3.0 * a.error * (h / a.knob).powi(4)))
                 .filter(|p| p.1 > y_d.0 && p.1 < y_d.1)
                 .collect();
             let gstyle = ShapeStyle::from(&RGBColor(120, 120, 120)).stroke_width(1);
