@@ -103,7 +103,9 @@ impl BenchConfig {
 
     /// Stability-map points per decade of kappa.
     pub fn map_per_decade(&self) -> usize {
-        if self.quick { 2 } else { 4 }
+        // Dense enough to catch the isolated kappa where fixed-step RK4 goes unstable in the
+        // unloading tail (found at 24 per decade: kappa = 75, 147, 421 for h = 1e-3).
+        if self.quick { 4 } else { 12 }
     }
 }
 

@@ -258,6 +258,14 @@ fn each_failure_of_the_map_is_an_error_value() {
             ContactEnd::Overlap,
             "unphysical",
         ),
+        // ... and at isolated kappa it ends still moving inward (p >= 0): before the check in
+        // viscoelastic::solve this came back as e = 0.502 against 2.2e-9.
+        (
+            VmSpec::Ode(rk4(1e-3)),
+            10f64.powf(1.875),
+            ContactEnd::Overlap,
+            "unphysical",
+        ),
         // Too large a step overshoots the loading phase.
         (
             VmSpec::Ode(rk4(0.5)),
@@ -429,4 +437,32 @@ fn cli_quick_run_writes_every_file_or_none() {
     assert!(err.starts_with("restitution: error: --out"), "{err}");
     assert!(out.stdout.is_empty());
     let _ = std::fs::remove_file(&blocker);
+}
+
+#[test]
+fn rk4_in_the_unstable_tail_fails_loudly() {
+    // Fixed-step RK4 (h = 1e-3, the map's setting) over kappa 10..1000 at 24 points per decade:
+    // each result is within 1e-6 of the reference or an error value (the unstable tail must never
+    // come back as a number; see each_failure_of_the_map_is_an_error_value).
+    let spec = VmSpec::Ode(OdeSettings::with_integrator(
+        Integrator::Rk4 {
+            h: bench::MAP_RK4_STEP,
+        },
+        0.0,
+    ));
+    for rule in ContactEnd::ALL {
+        for i in 0..=48 {
+            let kappa = 10f64.powf(1.0 + i as f64 / 24.0);
+            let (e_ref, ome_ref, _) = bench::reference::vm_dense_reference(kappa, rule).unwrap();
+            if let Ok(r) = spec.eval(kappa, rule) {
+                let err =
+                    (r.e - e_ref).abs().max((r.one_minus_e - ome_ref).abs()) / ome_ref.min(1.0);
+                assert!(
+                    err <= stability::MAP_TOL,
+                    "{rule} kappa={kappa}: e = {} against {e_ref}",
+                    r.e
+                );
+            }
+        }
+    }
 }

@@ -652,6 +652,19 @@ fn solve(kappa: f64, rule: ContactEnd, settings: &OdeSettings, extrema: bool) ->
 
     let (var, s, y) = end.expect("every path sets the end of contact");
     let (x_end, p_end) = x_p(var, s, &y);
+    // The bodies separate at the end of contact, so p_end < 0 always (overlap rule: p = -e; force
+    // rule: p = -x/kappa). p_end >= 0 means the integration went unstable in the slow unloading
+    // tail (fixed-step RK4, or loose tolerances at large kappa), and e from the energy balance
+    // below would be a wrong number near 0.5 (found by the bench's stability probe).
+    if p_end.is_nan() || p_end >= 0.0 {
+        return Err(Error::Integration {
+            method: settings.integrator.name(),
+            kappa,
+            reason: format!(
+                "unphysical result: not separating at the end of contact (p = {p_end})"
+            ),
+        });
+    }
     let x_end = if var == Var::Root && rule == ContactEnd::Overlap {
         0.0
     } else {
