@@ -469,7 +469,16 @@ pub type OutcomeSpan = (stability::Outcome, usize, f64, f64);
 /// For each map row (method, setting, rule), its non-`ok` outcomes.
 pub fn map_failures(cells: &[Cell]) -> Vec<(String, Vec<OutcomeSpan>)> {
     let mut keys: Vec<String> = Vec::new();
-    let key = |c: &Cell| format!("{} {} {} [{}]", c.model, c.method, c.setting, c.rule);
+    let key = |c: &Cell| {
+        let mut k = format!("{} {}", c.model, c.method);
+        if c.setting != "-" {
+            k.push_str(&format!(" {}", c.setting));
+        }
+        if c.rule != "-" {
+            k.push_str(&format!(" [{}]", c.rule));
+        }
+        k
+    };
     for c in cells {
         let k = key(c);
         if !keys.contains(&k) {
@@ -672,10 +681,22 @@ impl BenchReport {
             if fails.is_empty() {
                 let _ = writeln!(s, "- {k}: ok everywhere");
             } else {
+                // Plastic cells are located by u - 1 (they crowd at u = 1).
+                let (shift, var) = if k.starts_with("pm") {
+                    (1.0, "u - 1")
+                } else {
+                    (0.0, "kappa")
+                };
                 let parts: Vec<String> = fails
                     .iter()
                     .map(|(o, n, lo, hi)| {
-                        format!("{} x{} ({}..{})", o.name(), n, sci(*lo), sci(*hi))
+                        format!(
+                            "{} x{} ({var} = {}..{})",
+                            o.name(),
+                            n,
+                            sci(lo - shift),
+                            sci(hi - shift)
+                        )
                     })
                     .collect();
                 let _ = writeln!(s, "- {k}: {}", parts.join(", "));
