@@ -389,7 +389,9 @@ fn outcome_label(o: Outcome) -> &'static str {
         Outcome::Failed(F::StepSizeUnderflow) => "step-size underflow (error value)",
         Outcome::Failed(F::Stiffness) => "stiffness detected (error value)",
         Outcome::Failed(F::NonFinite) => "state not finite (error value)",
-        Outcome::Failed(F::Unphysical) => "e outside (0, 1] (error value)",
+        Outcome::Failed(F::Unphysical) => {
+            "unphysical end: e outside (0, 1] or not separating (error value)"
+        }
         Outcome::Failed(F::PhaseIncomplete) => "phase did not end (error value)",
         Outcome::Failed(F::Other) | Outcome::OtherError => "other error value",
     }
@@ -567,7 +569,7 @@ pub fn stability_svg(report: &BenchReport) -> Result<String, String> {
         )?;
         map_panel(
             &mid,
-            "plastic model: u = V/V_Y (reference points of the mpmath fixture)",
+            "plastic model: u = V/V_Y at the mpmath fixture's points (comparators are kept to show their failure)",
             "u - 1",
             &pm,
             |c| c.x - 1.0,
