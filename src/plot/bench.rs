@@ -189,16 +189,17 @@ pub fn work_precision_svg(report: &BenchReport) -> Result<String, String> {
             .filter(|r| r.method == "series" || r.method == "pade")
             .enumerate()
         {
-            // Alternate sides so that neighbouring labels do not overlap.
-            let (h, text) = if i % 2 == 0 {
-                (HPos::Left, format!("  {}", r.setting))
-            } else {
-                (HPos::Right, format!("{}  ", r.setting))
+            // Rotate the label around the point (above right, left, below right) so that
+            // neighbouring points' labels do not overlap.
+            let (h, v, text) = match i % 3 {
+                0 => (HPos::Left, VPos::Bottom, format!(" {}", r.setting)),
+                1 => (HPos::Right, VPos::Center, format!("{}  ", r.setting)),
+                _ => (HPos::Left, VPos::Top, format!(" {}", r.setting)),
             };
             let style = ("sans-serif", 15)
                 .into_font()
                 .into_text_style(&panels[0])
-                .pos(Pos::new(h, VPos::Center));
+                .pos(Pos::new(h, v));
             a.draw_series(std::iter::once(Text::new(
                 text,
                 (r.ns_per_eval, floor(r.error)),
