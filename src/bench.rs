@@ -32,6 +32,7 @@ use quadrature::WorkQuadrature;
 use reference::{PmRef, ReferenceCheck, VmRef, pm_fixture, vm_dense_reference, vm_fixture};
 use stability::{Cell, Role};
 use std::fmt::Write as _;
+use std::hint::black_box;
 use std::time::Duration;
 pub use timing::TimingPlan;
 pub use work_precision::{WpPoint, WpRow, fit_order};
@@ -252,6 +253,56 @@ pub struct BenchReport {
     /// Fitted convergence order of RK4 per rule: (rule, slope, points used).
     pub rk4_order: Vec<(String, f64, usize)>,
     pub candidates: Vec<OdeCandidate>,
+    /// The targets' methods timed point by point (the chart's figures are means over points).
+    pub per_point: Vec<PointTiming>,
+}
+
+/// The time of one method at one point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointTiming {
+    pub model: &'static str,
+    pub method: String,
+    /// `overlap`, `force` or `-`.
+    pub rule: String,
+    /// kappa or u.
+    pub x: f64,
+    pub ns_per_eval: f64,
+}
+
+/// Times the targets' methods (master curve, default ODE, plastic closed form) at each chart point.
+pub fn per_point_timing(
+    vm_refs: &[VmRef],
+    pm_refs: &[PmRef],
+    plan: &TimingPlan,
+) -> Vec<PointTiming> {
+    let mut out = Vec::new();
+    for spec in [VmSpec::Master, VmSpec::Ode(OdeSettings::DEFAULT)] {
+        for r in vm_refs {
+            let ns = timing::ns_per_eval(plan, 1, || {
+                spec.eval(black_box(r.kappa), r.rule).map_or(0.0, |x| x.e)
+            });
+            out.push(PointTiming {
+                model: "vm",
+                method: format!("{} {}", spec.method(), spec.setting()),
+                rule: r.rule.name().into(),
+                x: r.kappa,
+                ns_per_eval: ns,
+            });
+        }
+    }
+    for r in pm_refs.iter().filter(|r| r.u > 1.0) {
+        let ns = timing::ns_per_eval(plan, 1, || {
+            PmSpec::ClosedForm.eval(black_box(r.u)).map_or(0.0, |x| x.e)
+        });
+        out.push(PointTiming {
+            model: "pm",
+            method: PmSpec::ClosedForm.method(),
+            rule: "-".into(),
+            x: r.u,
+            ns_per_eval: ns,
+        });
+    }
+    out
 }
 
 /// Runs the whole bench. Fails only if a reference value cannot be computed.
@@ -289,6 +340,7 @@ pub fn run(cfg: &BenchConfig) -> Result<BenchReport> {
 
     let reference_check = reference::check_ode_reference()?;
     let candidates = ode_candidates(&kappas, &vm_refs, &plan)?;
+    let per_point = per_point_timing(&vm_refs, &pm_refs, &plan);
     Ok(BenchReport {
         config: *cfg,
         rows,
@@ -297,6 +349,7 @@ pub fn run(cfg: &BenchConfig) -> Result<BenchReport> {
         reference_check,
         rk4_order,
         candidates,
+        per_point,
     })
 }
 
@@ -453,6 +506,42 @@ impl BenchReport {
             );
         }
         s
+    }
+
+    /// `timing_per_point.csv`.
+    pub fn per_point_csv(&self) -> String {
+        let mut s = String::from("model,method,rule,x,ns_per_eval\n");
+        for p in &self.per_point {
+            let _ = writeln!(
+                s,
+                "{},{},{},{},{}",
+                p.model,
+                csv_text(&p.method),
+                p.rule,
+                csv_num(p.x),
+                csv_num(p.ns_per_eval)
+            );
+        }
+        s
+    }
+
+    /// (fastest, slowest) point of a method: (x, rule, ns) each.
+    pub fn point_range(&self, method: &str) -> Option<((f64, String, f64), (f64, String, f64))> {
+        let pts: Vec<&PointTiming> = self
+            .per_point
+            .iter()
+            .filter(|p| p.method == method)
+            .collect();
+        let lo = pts
+            .iter()
+            .min_by(|a, b| a.ns_per_eval.total_cmp(&b.ns_per_eval))?;
+        let hi = pts
+            .iter()
+            .max_by(|a, b| a.ns_per_eval.total_cmp(&b.ns_per_eval))?;
+        Some((
+            (lo.x, lo.rule.clone(), lo.ns_per_eval),
+            (hi.x, hi.rule.clone(), hi.ns_per_eval),
+        ))
     }
 
     /// The row of `method` at `setting` for `rule`.
@@ -614,6 +703,40 @@ impl BenchReport {
                 ulp_ome,
                 if met { "yes" } else { "no" }
             );
+        }
+        let _ = writeln!(
+            s,
+            "\nPer point (each chart point timed alone; the table's figures are the means):\n"
+        );
+        for (method, unit, scale) in [
+            ("master table", "ns", 1.0),
+            ("dop853 tol=1e-12", "us", 1e3),
+            ("closed form", "ns", 1.0),
+        ] {
+            if let Some((lo, hi)) = self.point_range(method) {
+                let x = if method == "closed form" {
+                    "u"
+                } else {
+                    "kappa"
+                };
+                let rule = |r: &str| {
+                    if r == "-" {
+                        String::new()
+                    } else {
+                        format!(", {r}")
+                    }
+                };
+                let _ = writeln!(
+                    s,
+                    "- {method}: {:.2} {unit} ({x} = {}{}) to {:.2} {unit} ({x} = {}{})",
+                    lo.2 / scale,
+                    fmt_num(lo.0),
+                    rule(&lo.1),
+                    hi.2 / scale,
+                    fmt_num(hi.0),
+                    rule(&hi.1)
+                );
+            }
         }
         let _ = writeln!(s, "\n## Achieved order of fixed-step RK4\n");
         for (rule, slope, n) in &self.rk4_order {

@@ -364,6 +364,7 @@ fn csv_outputs_have_the_required_columns() {
         },
         rk4_order: Vec::new(),
         candidates: Vec::new(),
+        per_point: Vec::new(),
     };
     let csv = report.work_precision_csv();
     let mut lines = csv.lines();
@@ -382,7 +383,7 @@ fn csv_outputs_have_the_required_columns() {
 
 #[test]
 fn cli_quick_run_writes_every_file_or_none() {
-    // The documented command at --quick (about a second on the dev box): all six files appear,
+    // The documented command at --quick (about a second on the dev box): all seven files appear,
     // with the columns the issue asks for; a bad --out is one line on stderr, exit 1, no files.
     let dir = std::env::temp_dir().join(format!("restitution-bench-test-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -402,6 +403,7 @@ fn cli_quick_run_writes_every_file_or_none() {
         "work_precision.svg",
         "stability.csv",
         "stability.svg",
+        "timing_per_point.csv",
         "summary.md",
     ] {
         let text = std::fs::read_to_string(dir.join(f)).unwrap();

@@ -5,6 +5,7 @@ use super::methods::{PmSpec, VmSpec};
 use super::reference::{PmRef, VmRef};
 use super::timing::{TimingPlan, ns_per_eval};
 use crate::models::viscoelastic::ContactEnd;
+use std::hint::black_box;
 
 /// One point of the chart: a method at one setting, for one rule (or `all` of its rules).
 #[derive(Debug, Clone, PartialEq)]
@@ -151,7 +152,7 @@ pub fn vm_rows(spec: &VmSpec, refs: &[VmRef], plan: &TimingPlan) -> (Vec<WpRow>,
         }
         let ns = ns_per_eval(plan, set.len(), || {
             set.iter()
-                .map(|r| spec.eval(r.kappa, rule).map_or(0.0, |x| x.e))
+                .map(|r| spec.eval(black_box(r.kappa), rule).map_or(0.0, |x| x.e))
                 .sum::<f64>()
         });
         all_ns += ns * set.len() as f64;
@@ -249,7 +250,7 @@ pub fn pm_rows(spec: &PmSpec, refs: &[PmRef], plan: &TimingPlan) -> (WpRow, Vec<
     }
     let ns = ns_per_eval(plan, set.len(), || {
         set.iter()
-            .map(|r| spec.eval(r.u).map_or(0.0, |x| x.e))
+            .map(|r| spec.eval(black_box(r.u)).map_or(0.0, |x| x.e))
             .sum::<f64>()
     });
     (

@@ -3,11 +3,12 @@
 //! ```text
 //! restitution bench [--out DIR] [--quick]
 //! ```
-//! Writes into DIR (default `reports/bench`, created if missing), all files or none:
+//! Writes into DIR (default `reports/bench`, created if missing), all seven files or none:
 //! `work_precision.csv` (model,method,setting,knob,rule,error,error_rel_e,error_rel_one_minus_e,
 //! ns_per_eval,rhs_evals,points,failed), `work_precision_points.csv` (every evaluation behind it),
 //! `work_precision.svg`, `stability.csv`, `stability.svg` and `summary.md` (targets, RK4 order,
-//! default-setting candidates, where each method fails). Prints the summary. `--quick` measures
+//! default-setting candidates, where each method fails) and `timing_per_point.csv` (the targets'
+//! methods timed at each point alone). Prints the summary. `--quick` measures
 //! fewer settings and points with shorter timing batches (well under a minute).
 
 use super::CliResult;
@@ -86,6 +87,10 @@ pub fn run(args: Args) -> CliResult {
             report.stability_csv().into_bytes(),
         ),
         (args.out.join("stability.svg"), st_svg.into_bytes()),
+        (
+            args.out.join("timing_per_point.csv"),
+            report.per_point_csv().into_bytes(),
+        ),
         (args.out.join("summary.md"), summary.clone().into_bytes()),
     ];
     write_all_atomic(&files).map_err(|e| format!("writing into {}: {e}", args.out.display()))?;
