@@ -279,7 +279,8 @@ pub fn per_point_timing(
     for spec in [VmSpec::Master, VmSpec::Ode(OdeSettings::DEFAULT)] {
         for r in vm_refs {
             let ns = timing::ns_per_eval(plan, 1, || {
-                spec.eval(black_box(r.kappa), r.rule).map_or(0.0, |x| x.e)
+                spec.eval(black_box(r.kappa), r.rule)
+                    .map_or(0.0, |x| x.e + x.one_minus_e)
             });
             out.push(PointTiming {
                 model: "vm",
@@ -292,7 +293,9 @@ pub fn per_point_timing(
     }
     for r in pm_refs.iter().filter(|r| r.u > 1.0) {
         let ns = timing::ns_per_eval(plan, 1, || {
-            PmSpec::ClosedForm.eval(black_box(r.u)).map_or(0.0, |x| x.e)
+            PmSpec::ClosedForm
+                .eval(black_box(r.u))
+                .map_or(0.0, |x| x.e + x.one_minus_e)
         });
         out.push(PointTiming {
             model: "pm",
@@ -525,23 +528,12 @@ impl BenchReport {
         s
     }
 
-    /// (fastest, slowest) point of a method: (x, rule, ns) each.
-    pub fn point_range(&self, method: &str) -> Option<((f64, String, f64), (f64, String, f64))> {
-        let pts: Vec<&PointTiming> = self
-            .per_point
-            .iter()
-            .filter(|p| p.method == method)
-            .collect();
-        let lo = pts
-            .iter()
-            .min_by(|a, b| a.ns_per_eval.total_cmp(&b.ns_per_eval))?;
-        let hi = pts
-            .iter()
-            .max_by(|a, b| a.ns_per_eval.total_cmp(&b.ns_per_eval))?;
-        Some((
-            (lo.x, lo.rule.clone(), lo.ns_per_eval),
-            (hi.x, hi.rule.clone(), hi.ns_per_eval),
-        ))
+    /// The fastest and the slowest point of a method.
+    pub fn point_range(&self, method: &str) -> Option<(&PointTiming, &PointTiming)> {
+        let pts = || self.per_point.iter().filter(|p| p.method == method);
+        let lo = pts().min_by(|a, b| a.ns_per_eval.total_cmp(&b.ns_per_eval))?;
+        let hi = pts().max_by(|a, b| a.ns_per_eval.total_cmp(&b.ns_per_eval))?;
+        Some((lo, hi))
     }
 
     /// The row of `method` at `setting` for `rule`.
@@ -729,12 +721,12 @@ impl BenchReport {
                 let _ = writeln!(
                     s,
                     "- {method}: {:.2} {unit} ({x} = {}{}) to {:.2} {unit} ({x} = {}{})",
-                    lo.2 / scale,
-                    fmt_num(lo.0),
-                    rule(&lo.1),
-                    hi.2 / scale,
-                    fmt_num(hi.0),
-                    rule(&hi.1)
+                    lo.ns_per_eval / scale,
+                    fmt_num(lo.x),
+                    rule(&lo.rule),
+                    hi.ns_per_eval / scale,
+                    fmt_num(hi.x),
+                    rule(&hi.rule)
                 );
             }
         }

@@ -1,6 +1,7 @@
 //! Wall-clock time per evaluation, measured warm: one untimed pass first, then `repeats` timed
 //! batches of whole passes over the points, each batch long enough to dwarf the clock's resolution.
-//! Callers pass their inputs through `black_box` too, so that nothing is hoisted out of the loop.
+//! Callers pass their inputs through `black_box` and return every output (e and 1 - e), so that
+//! nothing is hoisted out of the loop or dropped as unused.
 //! The figure reported is the **minimum** over the batches of (batch time / evaluations): noise on
 //! a shared machine only ever adds time, so the minimum is the least disturbed estimate.
 

@@ -152,7 +152,10 @@ pub fn vm_rows(spec: &VmSpec, refs: &[VmRef], plan: &TimingPlan) -> (Vec<WpRow>,
         }
         let ns = ns_per_eval(plan, set.len(), || {
             set.iter()
-                .map(|r| spec.eval(black_box(r.kappa), rule).map_or(0.0, |x| x.e))
+                .map(|r| {
+                    spec.eval(black_box(r.kappa), rule)
+                        .map_or(0.0, |x| x.e + x.one_minus_e)
+                })
                 .sum::<f64>()
         });
         all_ns += ns * set.len() as f64;
@@ -250,7 +253,10 @@ pub fn pm_rows(spec: &PmSpec, refs: &[PmRef], plan: &TimingPlan) -> (WpRow, Vec<
     }
     let ns = ns_per_eval(plan, set.len(), || {
         set.iter()
-            .map(|r| spec.eval(black_box(r.u)).map_or(0.0, |x| x.e))
+            .map(|r| {
+                spec.eval(black_box(r.u))
+                    .map_or(0.0, |x| x.e + x.one_minus_e)
+            })
             .sum::<f64>()
     });
     (
