@@ -25,8 +25,10 @@
 //!
 //! **Needs**: at least 3 frames per phase (free fits) or 2 (fixed gravity), distinct times.
 
+use crate::contact::{Material, Sphere};
 use crate::error::{Error, Result};
-use nalgebra::{DMatrix, DVector, Vector2};
+use crate::models::walton::{self, Body, Measured, State};
+use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 
 /// Standard gravity, m/s^2.
 pub const G_STANDARD_M_S2: f64 = 9.80665;
@@ -376,6 +378,88 @@ pub fn eq8_velocity_error_m_s(
     n_frames: usize,
 ) -> f64 {
     s_subpixels * subpixel_m / (dt_s * (n_frames as f64).sqrt())
+}
+
+/// The camera numbers Eq. (8) needs besides the frame interval and count.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Eq8Inputs {
+    /// Accuracy of a centre, subpixels (the paper: s = 1 +- 0.5 measured, 2 quoted).
+    pub s_subpixels: f64,
+    /// Size of a subpixel in the object plane, m.
+    pub subpixel_m: f64,
+}
+
+/// One collision measured from its tracks: the velocities, Walton's e, beta and psi from them
+/// ([`walton::measure`]), and two error estimates of e.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measurement {
+    pub kinematics: Kinematics,
+    pub pre: State,
+    pub post: State,
+    pub measured: Measured,
+    /// Standard error of e from the fits' covariance: e = -(v1' - v2').n / (v1 - v2).n with the
+    /// eight velocity components independent (the normal n is taken as exact).
+    pub e_err: f64,
+    /// Standard error of v_n from the fits' covariance, m/s.
+    pub v_n_err_m_s: f64,
+    /// Eq. (8) for a relative velocity component, with N the mean frames per phase, m/s.
+    pub eq8_dv_m_s: f64,
+    /// The paper's error of e from Eq. (8): Delta e = 2 e Delta v / v_n.
+    pub e_err_eq8: f64,
+}
+
+/// Runs the whole chain for one collision: fits, collision time, velocities, then Walton's
+/// measurement. `spins_rad_s` are the z spins [1 pre, 2 pre, 1 post, 2 post] from markers.
+#[allow(clippy::too_many_arguments)]
+pub fn measure_collision(
+    frames: &[Frame],
+    split: usize,
+    d1_m: f64,
+    d2_m: f64,
+    material: &Material,
+    inertia_k: f64,
+    spins_rad_s: [f64; 4],
+    kind: FitKind,
+    eq8: &Eq8Inputs,
+) -> Result<Measurement> {
+    let k = analyse(frames, split, d1_m, d2_m, kind)?;
+    let body = |d: f64, r: Vector2<f64>, v: Vector2<f64>, w: f64| -> Result<Body> {
+        let mut b = Body::homogeneous(Vector3::new(r.x, r.y, 0.0), &Sphere::new(d, *material)?);
+        b.inertia_k = inertia_k;
+        Ok(b.moving(Vector3::new(v.x, v.y, 0.0), Vector3::new(0.0, 0.0, w)))
+    };
+    let pre = State::pair(
+        body(d1_m, k.r1_m, k.v_m_s[0], spins_rad_s[0])?,
+        body(d2_m, k.r2_m, k.v_m_s[1], spins_rad_s[1])?,
+    );
+    let post = State::pair(
+        body(d1_m, k.r1_m, k.v_m_s[2], spins_rad_s[2])?,
+        body(d2_m, k.r2_m, k.v_m_s[3], spins_rad_s[3])?,
+    );
+    let measured = walton::measure(&pre, &post)?;
+    let n = (k.r1_m - k.r2_m).normalize();
+    let var_n =
+        |i: usize| n.x * n.x * k.v_err_m_s[i].x.powi(2) + n.y * n.y * k.v_err_m_s[i].y.powi(2);
+    let b = (k.v_m_s[0] - k.v_m_s[1]).dot(&n);
+    let e = measured.e;
+    let e_err = ((e * e * (var_n(0) + var_n(1)) + var_n(2) + var_n(3)) / (b * b)).sqrt();
+    let v_n_err = (var_n(0) + var_n(1)).sqrt();
+    let dt = frames
+        .windows(2)
+        .map(|w| w[1].t_s - w[0].t_s)
+        .fold(f64::INFINITY, f64::min);
+    let n_mean = (k.n_pre + k.n_post) / 2;
+    let eq8_dv = eq8_velocity_error_m_s(eq8.s_subpixels, eq8.subpixel_m, dt, n_mean);
+    Ok(Measurement {
+        e_err,
+        v_n_err_m_s: v_n_err,
+        eq8_dv_m_s: eq8_dv,
+        e_err_eq8: 2.0 * e * eq8_dv / measured.v_n_m_s,
+        kinematics: k,
+        pre,
+        post,
+        measured,
+    })
 }
 
 #[cfg(test)]
