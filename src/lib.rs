@@ -8,3 +8,4 @@ pub mod models;
 pub mod plot;
 
 pub use error::{Error, Result};
+pub mod fit;
