@@ -18,6 +18,8 @@ struct Cli {
 enum Command {
     /// e(v) from the viscoelastic or plastic model
     Predict(cli::predict::Args),
+    /// Fit eta and sigma_y (and more) to measured e(v_n), with uncertainties and a model comparison
+    Fit(cli::fit::Args),
 }
 
 fn main() -> ExitCode {
@@ -42,6 +44,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Predict(args) => cli::predict::run(args),
+        Command::Fit(args) => cli::fit::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

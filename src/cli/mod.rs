@@ -3,6 +3,7 @@
 
 use restitution::contact::{Material, PRESETS};
 
+pub mod fit;
 pub mod predict;
 
 /// What a subcommand returns: `Err` is one line for stderr (the binary prefixes it and exits 1).

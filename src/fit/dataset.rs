@@ -54,6 +54,11 @@ pub struct FitData {
     pub weighted: bool,
 }
 
+/// `x > 0` fails, NaN included.
+fn not_positive(x: f64) -> bool {
+    x.is_nan() || x <= 0.0
+}
+
 fn bad(name: &'static str, value: f64, expected: &'static str) -> Error {
     Error::InvalidParameter {
         name,
@@ -103,7 +108,7 @@ impl FitData {
                 return Err(bad("e_err", s, "a finite number > 0"));
             }
             if let Some(d2) = o.d2_mm
-                && !(d2 > 0.0)
+                && not_positive(d2)
             {
                 return Err(bad("d2 (mm)", d2, "a number > 0, or infinity for a wall"));
             }

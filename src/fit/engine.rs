@@ -401,8 +401,8 @@ fn scan_2d(obj: &Objective) -> Result<Vec<Vec<f64>>> {
     let combine = |x: f64, y: f64| if min_rule { x.min(y) } else { x * y };
     let chi2_with = |vm: &dyn Fn(usize) -> Result<f64>, pm: &[f64]| -> Result<f64> {
         let mut c = 0.0;
-        for i in 0..n {
-            let r = (combine(vm(i)?, pm[i]) - ev.data.obs[i].e) * obj.inv_sigma[i];
+        for (i, &p) in pm.iter().enumerate().take(n) {
+            let r = (combine(vm(i)?, p) - ev.data.obs[i].e) * obj.inv_sigma[i];
             c += r * r;
         }
         obj.evals.set(obj.evals.get() + 1);

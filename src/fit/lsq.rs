@@ -124,8 +124,9 @@ pub fn covariance(jac: &DMatrix<f64>) -> Covariance {
     };
     let norms: Vec<f64> = (0..p).map(|j| jac.column(j).norm()).collect();
     let live: Vec<usize> = (0..p).filter(|&j| norms[j] > 0.0).collect();
-    for j in 0..p {
-        out.no_effect[j] = !(norms[j] > 0.0);
+    for (flag, &norm) in out.no_effect.iter_mut().zip(&norms) {
+        // Also true for a NaN norm: such a column carries no usable information either.
+        *flag = norm.is_nan() || norm <= 0.0;
     }
     if live.is_empty() {
         return out;
@@ -487,8 +488,8 @@ mod tests {
             self.x.len()
         }
         fn residuals(&self, t: &[f64], out: &mut [f64]) -> Result<()> {
-            for i in 0..self.x.len() {
-                out[i] = t[0] * (-t[1] * self.x[i]).exp() - self.y[i];
+            for ((o, x), y) in out.iter_mut().zip(&self.x).zip(&self.y) {
+                *o = t[0] * (-t[1] * x).exp() - y;
             }
             Ok(())
         }

@@ -6,6 +6,7 @@ pub mod engine;
 pub mod input;
 pub mod lsq;
 pub mod models;
+pub mod report;
 
 pub use compare::{Comparison, ComparisonRow, compare};
 pub use dataset::{FitData, Group, Observation};
