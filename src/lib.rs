@@ -4,8 +4,10 @@
 pub mod contact;
 pub mod data;
 pub mod error;
+pub mod experiment;
+pub mod fit;
+pub mod kinematics;
 pub mod models;
 pub mod plot;
 
 pub use error::{Error, Result};
-pub mod fit;

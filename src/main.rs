@@ -20,6 +20,8 @@ enum Command {
     Predict(cli::predict::Args),
     /// Fit eta and sigma_y (and more) to measured e(v_n), with uncertainties and a model comparison
     Fit(cli::fit::Args),
+    /// Walton's collision operator: fit e, beta_0 and mu_0 to oblique collisions (Fig. 6)
+    Walton(cli::walton::Args),
 }
 
 fn main() -> ExitCode {
@@ -45,6 +47,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Predict(args) => cli::predict::run(args),
         Command::Fit(args) => cli::fit::run(args),
+        Command::Walton(args) => cli::walton::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

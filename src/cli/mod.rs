@@ -5,6 +5,7 @@ use restitution::contact::{Material, PRESETS};
 
 pub mod fit;
 pub mod predict;
+pub mod walton;
 
 /// What a subcommand returns: `Err` is one line for stderr (the binary prefixes it and exits 1).
 pub type CliResult = Result<(), String>;

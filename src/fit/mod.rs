@@ -7,6 +7,7 @@ pub mod input;
 pub mod lsq;
 pub mod models;
 pub mod report;
+pub mod walton;
 
 pub use compare::{Comparison, ComparisonRow, compare};
 pub use dataset::{FitData, Group, Observation};

@@ -2,3 +2,4 @@
 
 pub mod plastic;
 pub mod viscoelastic;
+pub mod walton;

@@ -384,6 +384,10 @@ fn integrate(
         u32::MAX
     };
     let h_max = (s1 - s0).abs();
+    // Every phase variable is O(1) over a contact, so a first step of 0.05 (or the whole span of a
+    // short refinement) is safe; the solver's own first guess starts near 1e-6 at r = 0, where the
+    // right side vanishes, and wastes steps growing from there.
+    let h0 = (s1 - s0).signum() * h_max.min(0.05);
     macro_rules! adaptive {
         ($solver:ident, $beta:expr) => {{
             let mut solver = $solver::from_param(
@@ -399,7 +403,7 @@ fn integrate(
                 0.333,
                 6.0,
                 h_max,
-                0.0,
+                h0,
                 settings.max_steps,
                 n_stiff,
                 OutputType::Sparse,
@@ -580,12 +584,10 @@ fn solve(kappa: f64, rule: ContactEnd, settings: &OdeSettings, extrema: bool) ->
             let (x, p) = x_p(var, s, &y);
             force_max = force(kappa, x, p);
         }
-        if rule == ContactEnd::Force {
-            if let Some(b) = &phase.brackets[Event::ForceZero as usize] {
-                let (s, y, n) = locate(kappa, var, Event::ForceZero, b, settings)?;
-                *evals += n;
-                return Ok(Some((s, y)));
-            }
+        if let (ContactEnd::Force, Some(b)) = (rule, &phase.brackets[Event::ForceZero as usize]) {
+            let (s, y, n) = locate(kappa, var, Event::ForceZero, b, settings)?;
+            *evals += n;
+            return Ok(Some((s, y)));
         }
         Ok(None)
     };
@@ -696,18 +698,13 @@ pub struct Restitution {
 }
 
 /// How e(kappa) is evaluated.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum VmMethod {
     /// The master-curve table inside its range, the default ODE outside it.
+    #[default]
     Master,
     /// The ODE at the given setting, for every point.
     Ode(OdeSettings),
-}
-
-impl Default for VmMethod {
-    fn default() -> Self {
-        VmMethod::Master
-    }
 }
 
 /// e(kappa) by the chosen method (the master curve falls back to the default ODE above

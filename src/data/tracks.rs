@@ -1,0 +1,230 @@
+//! The tracks schema: sphere centres per video frame, grouped by collision.
+//!
+//! Columns (header, any order): `collision` (an id), `t_s`, `x1_m,y1_m,x2_m,y2_m` (centres),
+//! `d1_mm,d2_mm`; optional `phase` (`pre`/`post`; when absent the split is found from the
+//! tracks), optional spins measured from markers `w1z_rad_s,w2z_rad_s` (before) and
+//! `w1z_post_rad_s,w2z_post_rad_s` (after), constant within a collision.
+
+use super::{DataError, Table};
+use crate::kinematics::Frame;
+use std::path::Path;
+
+/// The frames of one collision, sorted by time.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CollisionTrack {
+    pub id: String,
+    pub first_line: usize,
+    pub d1_m: f64,
+    pub d2_m: f64,
+    pub frames: Vec<Frame>,
+    /// Index of the first post-collision frame, when the file labels phases.
+    pub split: Option<usize>,
+    /// Spins about z, rad/s: [sphere 1 pre, sphere 2 pre, sphere 1 post, sphere 2 post].
+    pub spins_rad_s: Option<[f64; 4]>,
+}
+
+const SPIN_COLUMNS: [&str; 4] = ["w1z_rad_s", "w2z_rad_s", "w1z_post_rad_s", "w2z_post_rad_s"];
+
+/// Reads and validates a tracks file.
+pub fn read_tracks(path: &Path) -> Result<Vec<CollisionTrack>, DataError> {
+    parse_tracks(&Table::read(path)?)
+}
+
+/// Validates a tracks table (see the module doc for the columns).
+pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
+    let id_col = table.require("collision")?;
+    let t_col = table.require("t_s")?;
+    let pos = [
+        table.require("x1_m")?,
+        table.require("y1_m")?,
+        table.require("x2_m")?,
+        table.require("y2_m")?,
+    ];
+    let d1_col = table.require("d1_mm")?;
+    let d2_col = table.require("d2_mm")?;
+    let phase_col = table.column("phase");
+    let spin_cols: Vec<Option<usize>> = SPIN_COLUMNS.iter().map(|c| table.column(c)).collect();
+    let positive = |v: f64| v > 0.0;
+
+    struct Acc {
+        track: CollisionTrack,
+        phases: Vec<(bool, usize)>,
+    }
+    let mut accs: Vec<Acc> = Vec::new();
+    for row in &table.rows {
+        let id = row.fields[id_col].clone();
+        if id.is_empty() {
+            return Err(table.cell_error(row, id_col, "empty collision id"));
+        }
+        let t = table.number(row, t_col)?;
+        let mut p = [0.0; 4];
+        for (k, &c) in pos.iter().enumerate() {
+            p[k] = table.number(row, c)?;
+        }
+        let d1 = table.number_where(row, d1_col, positive, "a diameter > 0 (mm)")? * 1e-3;
+        let d2 = table.number_where(row, d2_col, positive, "a diameter > 0 (mm)")? * 1e-3;
+        let post = match phase_col {
+            None => None,
+            Some(c) => match row.fields[c].as_str() {
+                "pre" => Some(false),
+                "post" => Some(true),
+                other => {
+                    return Err(table.cell_error(
+                        row,
+                        c,
+                        format!("'{other}' is not a phase: expected pre or post"),
+                    ));
+                }
+            },
+        };
+        let mut spins = [f64::NAN; 4];
+        let mut have_spins = false;
+        for (k, c) in spin_cols.iter().enumerate() {
+            if let Some(c) = c.filter(|&c| !row.fields[c].is_empty()) {
+                spins[k] = table.number(row, c)?;
+                have_spins = true;
+            }
+        }
+        let i = match accs.iter().position(|a| a.track.id == id) {
+            Some(i) => i,
+            None => {
+                accs.push(Acc {
+                    track: CollisionTrack {
+                        id: id.clone(),
+                        first_line: row.line,
+                        d1_m: d1,
+                        d2_m: d2,
+                        frames: Vec::new(),
+                        split: None,
+                        spins_rad_s: None,
+                    },
+                    phases: Vec::new(),
+                });
+                accs.len() - 1
+            }
+        };
+        let acc = &mut accs[i];
+        if d1 != acc.track.d1_m {
+            return Err(table.cell_error(
+                row,
+                d1_col,
+                format!(
+                    "'{}' differs from the collision's first row (line {})",
+                    row.fields[d1_col], acc.track.first_line
+                ),
+            ));
+        }
+        if d2 != acc.track.d2_m {
+            return Err(table.cell_error(
+                row,
+                d2_col,
+                format!(
+                    "'{}' differs from the collision's first row (line {})",
+                    row.fields[d2_col], acc.track.first_line
+                ),
+            ));
+        }
+        if have_spins && acc.track.spins_rad_s.is_none() {
+            acc.track.spins_rad_s = Some(spins.map(|w| if w.is_nan() { 0.0 } else { w }));
+        }
+        if acc.track.frames.iter().any(|f| f.t_s == t) {
+            return Err(table.cell_error(
+                row,
+                t_col,
+                format!(
+                    "time {} appears twice in collision '{id}'",
+                    row.fields[t_col]
+                ),
+            ));
+        }
+        if let Some(post) = post {
+            acc.phases.push((post, row.line));
+        }
+        acc.track.frames.push(Frame {
+            t_s: t,
+            r1_m: [p[0], p[1]],
+            r2_m: [p[2], p[3]],
+        });
+    }
+
+    let mut out = Vec::new();
+    for mut acc in accs {
+        let mut order: Vec<usize> = (0..acc.track.frames.len()).collect();
+        order.sort_by(|&a, &b| acc.track.frames[a].t_s.total_cmp(&acc.track.frames[b].t_s));
+        acc.track.frames = order.iter().map(|&k| acc.track.frames[k]).collect();
+        if !acc.phases.is_empty() {
+            let phases: Vec<(bool, usize)> = order.iter().map(|&k| acc.phases[k]).collect();
+            let split = phases.iter().position(|p| p.0).unwrap_or(phases.len());
+            if let Some(bad) = phases[split..].iter().find(|p| !p.0) {
+                return Err(DataError {
+                    path: table.path.clone(),
+                    line: Some(bad.1),
+                    column: Some("phase".into()),
+                    message: format!(
+                        "a 'pre' frame comes after a 'post' frame in collision '{}'",
+                        acc.track.id
+                    ),
+                });
+            }
+            acc.track.split = Some(split);
+        }
+        out.push(acc.track);
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEAD: &str = "collision,t_s,x1_m,y1_m,x2_m,y2_m,d1_mm,d2_mm,phase\n";
+
+    #[test]
+    fn groups_sorts_and_splits() {
+        let text = format!(
+            "{HEAD}a,0.002,0,0,1,0,25.4,25.4,post\na,0.001,0,0,1,0,25.4,25.4,pre\n# c\nb,0.0,0,0,1,0,12.7,12.7,pre\n"
+        );
+        let t = parse_tracks(&Table::parse("t.csv", &text).unwrap()).unwrap();
+        assert_eq!(t.len(), 2);
+        assert_eq!(t[0].frames[0].t_s, 0.001);
+        assert_eq!(t[0].split, Some(1));
+        assert_eq!(t[1].first_line, 5);
+        assert_eq!(t[1].d1_m, 0.0127);
+    }
+
+    #[test]
+    fn errors_name_line_and_column() {
+        let bad = [
+            (
+                format!("{HEAD}a,0.1,0,0,1,0,25.4,25.4,during\n"),
+                "t.csv:2: column 'phase'",
+            ),
+            (
+                format!("{HEAD}a,0.1,0,0,1,0,25.4,25.4,pre\na,0.1,0,0,1,0,25.4,25.4,post\n"),
+                "t.csv:3: column 't_s'",
+            ),
+            (
+                format!("{HEAD}a,0.1,0,0,1,0,25.4,25.4,pre\na,0.2,0,0,1,0,12.7,25.4,post\n"),
+                "t.csv:3: column 'd1_mm'",
+            ),
+            (
+                format!("{HEAD}a,0.2,0,0,1,0,25.4,25.4,pre\na,0.1,0,0,1,0,25.4,25.4,post\n"),
+                "t.csv:2: column 'phase'",
+            ),
+            (
+                format!("{HEAD}a,0.1,0,x,1,0,25.4,25.4,pre\n"),
+                "t.csv:2: column 'y1_m'",
+            ),
+            (
+                format!("{HEAD}a,0.1,0,0,1,0,-1,25.4,pre\n"),
+                "t.csv:2: column 'd1_mm'",
+            ),
+        ];
+        for (text, want) in bad {
+            let e = parse_tracks(&Table::parse("t.csv", &text).unwrap())
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with(want), "{e}");
+        }
+    }
+}

@@ -1,0 +1,468 @@
+//! Kinematics from tracked sphere centres: Sec. III of Labous et al. (1997), PHYSICS.md §5.
+//!
+//! **Solves**: given the centres of two spheres in a sequence of video frames before and after a
+//! collision, the velocities of both spheres just before and just after it, with uncertainties.
+//!
+//! **Method** (the paper's): per sphere, per phase (pre/post) and per coordinate, a least-squares
+//! polynomial of degree two in time (`FitKind::Free`), or, with the acceleration known, a straight
+//! line plus the fixed gravitational term (`FitKind::FixedGravity`: x'' = 0, y'' = -g, y up).
+//! Fixing the acceleration removes the parameter most correlated with the end-point slope, and with
+//! the same noise the velocities come out several times more precise (see the virtual experiment).
+//!
+//! **Collision time.** Primary: the first instant, at or after the last pre-collision frame minus
+//! one frame interval, at which the centre distance on the pre-collision fits reaches
+//! (d1 + d2)/2, i.e. the spheres touch. It is defined by the approach alone, so it does not depend
+//! on the outcome being measured, and the distance changes at the normal speed, which pins the
+//! instant to about sigma/v_n. Fallback, flagged: when noise keeps the fitted centres from ever
+//! touching within the window, the instant where pre- and post-collision fits come closest (the
+//! centres are continuous through an instantaneous collision).
+//!
+//! **Uncertainties**: the covariance of each fit from the residual variance pooled over all the
+//! collision's fits (a fit of 10 frames alone estimates its own noise poorly), propagated to the
+//! velocities at the collision time. Eq. (8)'s Delta v = s d/(n_s dt sqrt N) is reported next to it:
+//! it ignores that the slope is taken at the end of the window, where a quadratic fit's slope has
+//! about 1.4 times that spread (PHYSICS.md §5).
+//!
+//! **Needs**: at least 3 frames per phase (free fits) or 2 (fixed gravity), distinct times.
+
+use crate::error::{Error, Result};
+use nalgebra::{DMatrix, DVector, Vector2};
+
+/// Standard gravity, m/s^2.
+pub const G_STANDARD_M_S2: f64 = 9.80665;
+
+/// How each coordinate is fitted in time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum FitKind {
+    /// x(t) = a + b t + c t^2 for every coordinate (the paper's).
+    Free,
+    /// x(t) = a + b t, y(t) = a + b t - g t^2/2 (y up).
+    FixedGravity { g_m_s2: f64 },
+}
+
+impl FitKind {
+    fn params(self) -> usize {
+        match self {
+            FitKind::Free => 3,
+            FitKind::FixedGravity { .. } => 2,
+        }
+    }
+}
+
+/// One video frame: time and the two centres (x, y), metres.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    pub t_s: f64,
+    pub r1_m: [f64; 2],
+    pub r2_m: [f64; 2],
+}
+
+/// A least-squares polynomial in tau = t - t_ref: value = c0 + c1 tau + c2 tau^2. With fixed
+/// gravity c2 is the known -g/2 (or 0) and only c0, c1 are fitted.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PolyFit {
+    pub t_ref_s: f64,
+    pub coef: [f64; 3],
+    /// (X^T X)^-1 of the fitted parameters: times the noise variance it is their covariance.
+    pub xtx_inv: DMatrix<f64>,
+    pub rss: f64,
+    pub n: usize,
+}
+
+impl PolyFit {
+    fn fit(t: &[f64], y: &[f64], fixed_c2: Option<f64>) -> Result<PolyFit> {
+        let n = t.len();
+        let p = if fixed_c2.is_some() { 2 } else { 3 };
+        let t_ref = t.iter().sum::<f64>() / n as f64;
+        let x = DMatrix::from_fn(n, p, |i, j| (t[i] - t_ref).powi(j as i32));
+        let c2 = fixed_c2.unwrap_or(0.0);
+        let rhs = DVector::from_fn(n, |i, _| y[i] - c2 * (t[i] - t_ref).powi(2));
+        let xtx = x.transpose() * &x;
+        let xtx_inv = xtx.try_inverse().ok_or(Error::InvalidParameter {
+            name: "frame times",
+            value: t_ref,
+            expected: "distinct times in each phase",
+        })?;
+        let beta = &xtx_inv * (x.transpose() * &rhs);
+        let resid = &rhs - &x * &beta;
+        let coef = [beta[0], beta[1], if p == 3 { beta[2] } else { c2 }];
+        Ok(PolyFit {
+            t_ref_s: t_ref,
+            coef,
+            xtx_inv,
+            rss: resid.norm_squared(),
+            n,
+        })
+    }
+
+    pub fn value(&self, t_s: f64) -> f64 {
+        let tau = t_s - self.t_ref_s;
+        self.coef[0] + tau * (self.coef[1] + tau * self.coef[2])
+    }
+
+    pub fn slope(&self, t_s: f64) -> f64 {
+        let tau = t_s - self.t_ref_s;
+        self.coef[1] + 2.0 * tau * self.coef[2]
+    }
+
+    /// Variance of the slope at `t_s` per unit noise variance: J (X^T X)^-1 J^T, J = (0, 1, 2 tau).
+    pub fn slope_variance_factor(&self, t_s: f64) -> f64 {
+        let tau = t_s - self.t_ref_s;
+        let j = [0.0, 1.0, 2.0 * tau];
+        let p = self.xtx_inv.nrows();
+        let mut v = 0.0;
+        for a in 0..p {
+            for b in 0..p {
+                v += j[a] * self.xtx_inv[(a, b)] * j[b];
+            }
+        }
+        v
+    }
+}
+
+/// The four fits (x, y of sphere 1 and 2) of one phase.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PhaseFit {
+    pub fits: [PolyFit; 4],
+    pub t_first_s: f64,
+    pub t_last_s: f64,
+}
+
+impl PhaseFit {
+    fn new(frames: &[Frame], kind: FitKind) -> Result<PhaseFit> {
+        let t: Vec<f64> = frames.iter().map(|f| f.t_s).collect();
+        let coord = |k: usize| -> Vec<f64> {
+            frames
+                .iter()
+                .map(|f| if k < 2 { f.r1_m[k] } else { f.r2_m[k - 2] })
+                .collect()
+        };
+        let fixed = |k: usize| match kind {
+            FitKind::Free => None,
+            FitKind::FixedGravity { g_m_s2 } => Some(if k % 2 == 1 { -0.5 * g_m_s2 } else { 0.0 }),
+        };
+        let fit = |k: usize| PolyFit::fit(&t, &coord(k), fixed(k));
+        Ok(PhaseFit {
+            fits: [fit(0)?, fit(1)?, fit(2)?, fit(3)?],
+            t_first_s: t.iter().cloned().fold(f64::INFINITY, f64::min),
+            t_last_s: t.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
+        })
+    }
+
+    fn position(&self, sphere: usize, t_s: f64) -> Vector2<f64> {
+        Vector2::new(
+            self.fits[2 * sphere].value(t_s),
+            self.fits[2 * sphere + 1].value(t_s),
+        )
+    }
+
+    fn velocity(&self, sphere: usize, t_s: f64) -> Vector2<f64> {
+        Vector2::new(
+            self.fits[2 * sphere].slope(t_s),
+            self.fits[2 * sphere + 1].slope(t_s),
+        )
+    }
+
+    fn velocity_var_factor(&self, sphere: usize, t_s: f64) -> Vector2<f64> {
+        Vector2::new(
+            self.fits[2 * sphere].slope_variance_factor(t_s),
+            self.fits[2 * sphere + 1].slope_variance_factor(t_s),
+        )
+    }
+}
+
+/// How the collision time was found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum TimeRule {
+    /// Centre distance on the pre-collision fits reaches (d1 + d2)/2.
+    ContactDistance,
+    /// Fallback: where the pre- and post-collision fits come closest.
+    FitsMeet,
+}
+
+impl TimeRule {
+    pub fn name(self) -> &'static str {
+        match self {
+            TimeRule::ContactDistance => "contact_distance",
+            TimeRule::FitsMeet => "fits_meet",
+        }
+    }
+}
+
+/// Velocities of both spheres before and after, at the collision time, with standard errors.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Kinematics {
+    pub t_c_s: f64,
+    pub time_rule: TimeRule,
+    /// Centres at t_c from the pre-collision fits.
+    pub r1_m: Vector2<f64>,
+    pub r2_m: Vector2<f64>,
+    /// Velocities: [sphere 1 pre, sphere 2 pre, sphere 1 post, sphere 2 post].
+    pub v_m_s: [Vector2<f64>; 4],
+    /// Standard errors of each velocity component, same order.
+    pub v_err_m_s: [Vector2<f64>; 4],
+    /// Pooled position noise estimated from the fit residuals, m.
+    pub sigma_pos_m: f64,
+    pub n_pre: usize,
+    pub n_post: usize,
+    pub pre: PhaseFit,
+    pub post: PhaseFit,
+}
+
+/// Splits frames into pre and post phases when the tracks carry no phase label: frames up to the
+/// closest approach are "pre", the rest "post"; the closest frame itself goes to whichever side
+/// leaves the smaller total residual (it may be the last frame before contact or the first after).
+pub fn split_at_contact(frames: &[Frame], kind: FitKind) -> Result<usize> {
+    let need = kind.params();
+    let dist =
+        |f: &Frame| ((f.r1_m[0] - f.r2_m[0]).powi(2) + (f.r1_m[1] - f.r2_m[1]).powi(2)).sqrt();
+    let k_min = (0..frames.len())
+        .min_by(|&a, &b| dist(&frames[a]).total_cmp(&dist(&frames[b])))
+        .ok_or(Error::InvalidParameter {
+            name: "frames",
+            value: 0.0,
+            expected: "at least one frame",
+        })?;
+    let rss = |split: usize| -> Option<f64> {
+        if split < need || frames.len() - split < need {
+            return None;
+        }
+        let a = PhaseFit::new(&frames[..split], kind).ok()?;
+        let b = PhaseFit::new(&frames[split..], kind).ok()?;
+        Some(a.fits.iter().chain(b.fits.iter()).map(|f| f.rss).sum())
+    };
+    match (rss(k_min + 1), rss(k_min)) {
+        (Some(a), Some(b)) => Ok(if a <= b { k_min + 1 } else { k_min }),
+        (Some(_), None) => Ok(k_min + 1),
+        (None, Some(_)) => Ok(k_min),
+        (None, None) => Err(Error::InvalidParameter {
+            name: "frames per phase",
+            value: frames.len() as f64,
+            expected: "enough frames on both sides of the closest approach",
+        }),
+    }
+}
+
+/// Fits both phases and extracts the velocities at the collision time. `frames` must be sorted by
+/// time; `split` is the index of the first post-collision frame.
+pub fn analyse(
+    frames: &[Frame],
+    split: usize,
+    d1_m: f64,
+    d2_m: f64,
+    kind: FitKind,
+) -> Result<Kinematics> {
+    let need = kind.params();
+    let (pre_frames, post_frames) = frames.split_at(split.min(frames.len()));
+    if pre_frames.len() < need || post_frames.len() < need {
+        return Err(Error::InvalidParameter {
+            name: "frames per phase",
+            value: pre_frames.len().min(post_frames.len()) as f64,
+            expected: if need == 3 {
+                "at least 3 frames before and after the collision (2 with fixed gravity)"
+            } else {
+                "at least 2 frames before and after the collision"
+            },
+        });
+    }
+    let pre = PhaseFit::new(pre_frames, kind)?;
+    let post = PhaseFit::new(post_frames, kind)?;
+    let dt = if frames.len() > 1 {
+        (frames[frames.len() - 1].t_s - frames[0].t_s) / (frames.len() - 1) as f64
+    } else {
+        0.0
+    };
+    let (lo, hi) = (pre.t_last_s - dt, post.t_first_s + dt);
+    let contact = 0.5 * (d1_m + d2_m);
+    let gap = |t: f64| (pre.position(0, t) - pre.position(1, t)).norm() - contact;
+    let mismatch = |t: f64| {
+        (0..2)
+            .map(|s| (pre.position(s, t) - post.position(s, t)).norm_squared())
+            .sum::<f64>()
+    };
+    let (t_c, rule) = match first_crossing(&gap, lo, hi) {
+        Some(t) => (t, TimeRule::ContactDistance),
+        None => (argmin_scan(&mismatch, lo, hi), TimeRule::FitsMeet),
+    };
+    // Pooled residual variance over all eight fits.
+    let all = pre.fits.iter().chain(post.fits.iter());
+    let (rss, dof) = all.fold((0.0, 0usize), |(r, d), f| (r + f.rss, d + f.n - need));
+    let sigma2 = if dof > 0 { rss / dof as f64 } else { f64::NAN };
+    let v = [
+        pre.velocity(0, t_c),
+        pre.velocity(1, t_c),
+        post.velocity(0, t_c),
+        post.velocity(1, t_c),
+    ];
+    let factor = [
+        pre.velocity_var_factor(0, t_c),
+        pre.velocity_var_factor(1, t_c),
+        post.velocity_var_factor(0, t_c),
+        post.velocity_var_factor(1, t_c),
+    ];
+    let v_err = factor.map(|f| f.map(|x| (x * sigma2).sqrt()));
+    Ok(Kinematics {
+        t_c_s: t_c,
+        time_rule: rule,
+        r1_m: pre.position(0, t_c),
+        r2_m: pre.position(1, t_c),
+        v_m_s: v,
+        v_err_m_s: v_err,
+        sigma_pos_m: sigma2.sqrt(),
+        n_pre: pre_frames.len(),
+        n_post: post_frames.len(),
+        pre,
+        post,
+    })
+}
+
+/// First crossing of f from > 0 to <= 0 on [lo, hi], by a scan and bisection to rounding.
+fn first_crossing(f: &impl Fn(f64) -> f64, lo: f64, hi: f64) -> Option<f64> {
+    const N: usize = 200;
+    let mut a = lo;
+    let mut fa = f(a);
+    for i in 1..=N {
+        let b = lo + (hi - lo) * i as f64 / N as f64;
+        let fb = f(b);
+        if fa > 0.0 && fb <= 0.0 {
+            let (mut x0, mut x1) = (a, b);
+            for _ in 0..100 {
+                let m = 0.5 * (x0 + x1);
+                if m <= x0 || m >= x1 {
+                    break;
+                }
+                if f(m) > 0.0 { x0 = m } else { x1 = m }
+            }
+            return Some(0.5 * (x0 + x1));
+        }
+        a = b;
+        fa = fb;
+    }
+    None
+}
+
+/// Minimiser of f on [lo, hi]: a scan, then golden-section refinement around the best point.
+fn argmin_scan(f: &impl Fn(f64) -> f64, lo: f64, hi: f64) -> f64 {
+    const N: usize = 200;
+    let h = (hi - lo) / N as f64;
+    let best = (0..=N)
+        .map(|i| lo + h * i as f64)
+        .min_by(|a, b| f(*a).total_cmp(&f(*b)))
+        .unwrap_or(lo);
+    let (mut a, mut b) = ((best - h).max(lo), (best + h).min(hi));
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..100 {
+        let c = b - g * (b - a);
+        let d = a + g * (b - a);
+        if f(c) < f(d) {
+            b = d
+        } else {
+            a = c
+        }
+        if b - a <= 1e-15 * b.abs().max(1e-300) {
+            break;
+        }
+    }
+    0.5 * (a + b)
+}
+
+/// Eq. (8): Delta v = s d/(n_s dt sqrt N) = s * (subpixel size)/(dt sqrt N), with s the position
+/// accuracy in subpixels, the subpixel size in metres, dt the frame interval and N the frames in
+/// the fit. Optimistic for a slope at the end of the frame window (PHYSICS.md §5).
+pub fn eq8_velocity_error_m_s(
+    s_subpixels: f64,
+    subpixel_m: f64,
+    dt_s: f64,
+    n_frames: usize,
+) -> f64 {
+    s_subpixels * subpixel_m / (dt_s * (n_frames as f64).sqrt())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ballistic(t: f64, r0: [f64; 2], v0: [f64; 2], g: f64) -> [f64; 2] {
+        [r0[0] + v0[0] * t, r0[1] + v0[1] * t - 0.5 * g * t * t]
+    }
+
+    /// Head-on collision at t = 0 of two 10 mm spheres with exact (noise-free) tracks.
+    fn frames(e: f64) -> Vec<Frame> {
+        let g = G_STANDARD_M_S2;
+        let d = 0.01;
+        let (u1, u2) = (1.0, -1.0);
+        let (w1, w2) = (-e, e); // equal masses, head-on: velocities swap sign times e
+        let mut out = Vec::new();
+        for k in -10..=10 {
+            if k == 0 {
+                continue;
+            }
+            let t = k as f64 * 1e-3 + 0.3e-3;
+            let (v1, v2) = if t < 0.0 { (u1, u2) } else { (w1, w2) };
+            let r1 = ballistic(t, [-d / 2.0, 0.0], [v1, 0.0], g);
+            let r2 = ballistic(t, [d / 2.0, 0.0], [v2, 0.0], g);
+            out.push(Frame {
+                t_s: t,
+                r1_m: r1,
+                r2_m: r2,
+            });
+        }
+        out
+    }
+
+    #[test]
+    fn exact_tracks_give_exact_velocities() {
+        let f = frames(0.8);
+        let split = split_at_contact(&f, FitKind::Free).unwrap();
+        assert_eq!(split, 10);
+        for kind in [
+            FitKind::Free,
+            FitKind::FixedGravity {
+                g_m_s2: G_STANDARD_M_S2,
+            },
+        ] {
+            let k = analyse(&f, split, 0.01, 0.01, kind).unwrap();
+            assert_eq!(k.time_rule, TimeRule::ContactDistance);
+            // Contact at t = 0: the centres are 10 mm apart then (closed form of the tracks).
+            assert!(k.t_c_s.abs() < 1e-12, "{}", k.t_c_s);
+            // Quadratic fits are exact on ballistic tracks: slopes to rounding.
+            let want = [[1.0, 0.0], [-1.0, 0.0], [-0.8, 0.0], [0.8, 0.0]];
+            for (v, w) in k.v_m_s.iter().zip(want) {
+                assert!(
+                    (v.x - w[0]).abs() < 1e-9 && (v.y - w[1]).abs() < 1e-9,
+                    "{v:?} {w:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn slope_variance_at_the_window_end_exceeds_eq8() {
+        // PHYSICS.md §5: a quadratic's slope half a frame past the end of a 10-frame window has
+        // sd 0.4489 sigma/dt (normal equations solved by hand, independently), not Eq. (8)'s
+        // sigma/(dt sqrt 10) = 0.3162 sigma/dt; at the last frame itself it is 0.4069.
+        let t: Vec<f64> = (0..10).map(|k| k as f64).collect();
+        let y = vec![0.0; 10];
+        let f = PolyFit::fit(&t, &y, None).unwrap();
+        let end = f.slope_variance_factor(9.5).sqrt();
+        assert!((end - 0.4489043901713944).abs() < 1e-12, "{end}");
+        assert!((f.slope_variance_factor(9.0).sqrt() - 0.4068541544955674).abs() < 1e-12);
+        assert!((eq8_velocity_error_m_s(1.0, 1.0, 1.0, 10) - 0.316227766).abs() < 1e-9);
+    }
+
+    #[test]
+    fn too_few_frames_is_an_error() {
+        let f = frames(0.8);
+        assert!(analyse(&f[8..12], 2, 0.01, 0.01, FitKind::Free).is_err());
+        assert!(
+            analyse(
+                &f[8..12],
+                2,
+                0.01,
+                0.01,
+                FitKind::FixedGravity { g_m_s2: 9.8 }
+            )
+            .is_ok()
+        );
+    }
+}
