@@ -18,6 +18,8 @@ struct Cli {
 enum Command {
     /// e(v) from the viscoelastic or plastic model
     Predict(cli::predict::Args),
+    /// Fit eta and sigma_y (and more) to measured e(v_n), with uncertainties and a model comparison
+    Fit(cli::fit::Args),
     /// Velocities, e, beta and psi from tracked sphere centres (Sec. III)
     Kinematics(cli::kinematics::Args),
     /// Walton's collision operator: fit e, beta_0 and mu_0 to oblique collisions (Fig. 6)
@@ -46,6 +48,7 @@ fn main() -> ExitCode {
     };
     let result = match cli.command {
         Command::Predict(args) => cli::predict::run(args),
+        Command::Fit(args) => cli::fit::run(args),
         Command::Walton(args) => cli::walton::run(args),
         Command::Kinematics(args) => cli::kinematics::run(args),
     };

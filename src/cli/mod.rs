@@ -3,6 +3,7 @@
 
 use restitution::contact::{Material, PRESETS};
 
+pub mod fit;
 pub mod kinematics;
 pub mod predict;
 pub mod walton;
