@@ -110,7 +110,16 @@ impl PolyFit {
     /// Variance of the slope at `t_s` per unit noise variance: J (X^T X)^-1 J^T, J = (0, 1, 2 tau).
     pub fn slope_variance_factor(&self, t_s: f64) -> f64 {
         let tau = t_s - self.t_ref_s;
-        let j = [0.0, 1.0, 2.0 * tau];
+        self.variance_factor([0.0, 1.0, 2.0 * tau])
+    }
+
+    /// Variance of the value at `t_s` per unit noise variance: J = (1, tau, tau^2).
+    pub fn value_variance_factor(&self, t_s: f64) -> f64 {
+        let tau = t_s - self.t_ref_s;
+        self.variance_factor([1.0, tau, tau * tau])
+    }
+
+    fn variance_factor(&self, j: [f64; 3]) -> f64 {
         let p = self.xtx_inv.nrows();
         let mut v = 0.0;
         for a in 0..p {
@@ -201,10 +210,13 @@ pub struct Kinematics {
     pub r2_m: Vector2<f64>,
     /// Velocities: [sphere 1 pre, sphere 2 pre, sphere 1 post, sphere 2 post].
     pub v_m_s: [Vector2<f64>; 4],
-    /// Standard errors of each velocity component, same order.
-    pub v_err_m_s: [Vector2<f64>; 4],
-    /// Pooled position noise estimated from the fit residuals, m.
-    pub sigma_pos_m: f64,
+    /// Variance of each velocity component per unit position-noise variance, same order.
+    pub v_var_factor_per_m2: [Vector2<f64>; 4],
+    /// Variance of the centres' coordinates at t_c (pre fits) per unit noise variance: [r1, r2].
+    pub r_var_factor: [Vector2<f64>; 2],
+    /// Sum of squared residuals over the eight fits, m^2, and its degrees of freedom.
+    pub rss_m2: f64,
+    pub dof: usize,
     pub n_pre: usize,
     pub n_post: usize,
     pub pre: PhaseFit,
@@ -286,10 +298,8 @@ pub fn analyse(
         Some(t) => (t, TimeRule::ContactDistance),
         None => (argmin_scan(&mismatch, lo, hi), TimeRule::FitsMeet),
     };
-    // Pooled residual variance over all eight fits.
     let all = pre.fits.iter().chain(post.fits.iter());
     let (rss, dof) = all.fold((0.0, 0usize), |(r, d), f| (r + f.rss, d + f.n - need));
-    let sigma2 = if dof > 0 { rss / dof as f64 } else { f64::NAN };
     let v = [
         pre.velocity(0, t_c),
         pre.velocity(1, t_c),
@@ -302,15 +312,21 @@ pub fn analyse(
         post.velocity_var_factor(0, t_c),
         post.velocity_var_factor(1, t_c),
     ];
-    let v_err = factor.map(|f| f.map(|x| (x * sigma2).sqrt()));
     Ok(Kinematics {
         t_c_s: t_c,
         time_rule: rule,
         r1_m: pre.position(0, t_c),
         r2_m: pre.position(1, t_c),
         v_m_s: v,
-        v_err_m_s: v_err,
-        sigma_pos_m: sigma2.sqrt(),
+        v_var_factor_per_m2: factor,
+        r_var_factor: [0, 1].map(|s| {
+            Vector2::new(
+                pre.fits[2 * s].value_variance_factor(t_c),
+                pre.fits[2 * s + 1].value_variance_factor(t_c),
+            )
+        }),
+        rss_m2: rss,
+        dof,
         n_pre: pre_frames.len(),
         n_post: post_frames.len(),
         pre,
@@ -397,8 +413,14 @@ pub struct Measurement {
     pub pre: State,
     pub post: State,
     pub measured: Measured,
+    /// The position noise the errors below assume, m.
+    pub sigma_pos_m: f64,
+    /// Standard errors of each velocity component: [1 pre, 2 pre, 1 post, 2 post], m/s.
+    pub v_err_m_s: [Vector2<f64>; 4],
     /// Standard error of e from the fits' covariance: e = -(v1' - v2').n / (v1 - v2).n with the
-    /// eight velocity components independent (the normal n is taken as exact).
+    /// eight velocity components independent, plus the error of the normal's direction from the
+    /// centres' positions and the collision time (de/dtheta = -(dv'.t + e dv.t)/(dv.n); both
+    /// large for grazing impacts).
     pub e_err: f64,
     /// Standard error of v_n from the fits' covariance, m/s.
     pub v_n_err_m_s: f64,
@@ -410,6 +432,11 @@ pub struct Measurement {
 
 /// Runs the whole chain for one collision: fits, collision time, velocities, then Walton's
 /// measurement. `spins_rad_s` are the z spins [1 pre, 2 pre, 1 post, 2 post] from markers.
+///
+/// `sigma_pos_m` is the position noise behind the error estimates. `None` estimates it from this
+/// collision's residuals, or, without residual degrees of freedom (3 frames a phase with free
+/// fits), takes the camera's stated accuracy s x subpixel. A caller with many collisions from one
+/// camera does better to pool the residuals over all of them ([`Kinematics::rss_m2`], `dof`).
 #[allow(clippy::too_many_arguments)]
 pub fn measure_collision(
     frames: &[Frame],
@@ -421,8 +448,17 @@ pub fn measure_collision(
     spins_rad_s: [f64; 4],
     kind: FitKind,
     eq8: &Eq8Inputs,
+    sigma_pos_m: Option<f64>,
 ) -> Result<Measurement> {
     let k = analyse(frames, split, d1_m, d2_m, kind)?;
+    let sigma = match sigma_pos_m {
+        Some(s) => s,
+        None if k.dof > 0 => (k.rss_m2 / k.dof as f64).sqrt(),
+        None => eq8.s_subpixels * eq8.subpixel_m,
+    };
+    let v_err = k
+        .v_var_factor_per_m2
+        .map(|f| f.map(|x| (x * sigma * sigma).sqrt()));
     let body = |d: f64, r: Vector2<f64>, v: Vector2<f64>, w: f64| -> Result<Body> {
         let mut b = Body::homogeneous(Vector3::new(r.x, r.y, 0.0), &Sphere::new(d, *material)?);
         b.inertia_k = inertia_k;
@@ -438,11 +474,29 @@ pub fn measure_collision(
     );
     let measured = walton::measure(&pre, &post)?;
     let n = (k.r1_m - k.r2_m).normalize();
-    let var_n =
-        |i: usize| n.x * n.x * k.v_err_m_s[i].x.powi(2) + n.y * n.y * k.v_err_m_s[i].y.powi(2);
+    let var_n = |i: usize| n.x * n.x * v_err[i].x.powi(2) + n.y * n.y * v_err[i].y.powi(2);
     let b = (k.v_m_s[0] - k.v_m_s[1]).dot(&n);
     let e = measured.e;
-    let e_err = ((e * e * (var_n(0) + var_n(1)) + var_n(2) + var_n(3)) / (b * b)).sqrt();
+    let t_hat = Vector2::new(-n.y, n.x);
+    let var_along = |i: usize, u: &Vector2<f64>| {
+        let f = k.r_var_factor[i];
+        (u.x * u.x * f.x + u.y * u.y * f.y) * sigma * sigma
+    };
+    // The normal is the direction of r1 - r2 when |r1 - r2| = (d1 + d2)/2. A position error
+    // along n shifts that instant by delta/v_n, during which r1 - r2 turns at v_t/|r1 - r2|; an
+    // error across n turns it directly. Both matter most for grazing impacts.
+    let rel_v = k.v_m_s[0] - k.v_m_s[1];
+    let turn = rel_v.dot(&t_hat) / rel_v.dot(&n);
+    let var_theta = (var_along(0, &t_hat)
+        + var_along(1, &t_hat)
+        + turn * turn * (var_along(0, &n) + var_along(1, &n)))
+        / (k.r1_m - k.r2_m).norm_squared();
+    let dv_post_t = (k.v_m_s[2] - k.v_m_s[3]).dot(&t_hat);
+    let dv_pre_t = (k.v_m_s[0] - k.v_m_s[1]).dot(&t_hat);
+    let de_dtheta = -(dv_post_t + measured.e * dv_pre_t) / b;
+    let e_err = ((e * e * (var_n(0) + var_n(1)) + var_n(2) + var_n(3)) / (b * b)
+        + de_dtheta * de_dtheta * var_theta)
+        .sqrt();
     let v_n_err = (var_n(0) + var_n(1)).sqrt();
     let dt = frames
         .windows(2)
@@ -451,6 +505,8 @@ pub fn measure_collision(
     let n_mean = (k.n_pre + k.n_post) / 2;
     let eq8_dv = eq8_velocity_error_m_s(eq8.s_subpixels, eq8.subpixel_m, dt, n_mean);
     Ok(Measurement {
+        sigma_pos_m: sigma,
+        v_err_m_s: v_err,
         e_err,
         v_n_err_m_s: v_n_err,
         eq8_dv_m_s: eq8_dv,

@@ -24,7 +24,7 @@ use restitution::data::{fmt_num, write_all_atomic};
 use restitution::experiment::Camera;
 use restitution::fit::walton::{CollisionRecord, write_collisions};
 use restitution::kinematics::{
-    Eq8Inputs, FitKind, G_STANDARD_M_S2, Measurement, measure_collision, split_at_contact,
+    Eq8Inputs, FitKind, G_STANDARD_M_S2, Measurement, analyse, measure_collision, split_at_contact,
 };
 use restitution::models::walton::K_HOMOGENEOUS;
 use std::path::PathBuf;
@@ -109,7 +109,13 @@ impl Row {
     fn cells(&self) -> Vec<String> {
         let k = &self.m.kinematics;
         let me = &self.m.measured;
-        let v_err = k.v_err_m_s.iter().map(|v| v.norm_squared()).sum::<f64>() / 8.0;
+        let v_err = self
+            .m
+            .v_err_m_s
+            .iter()
+            .map(|v| v.norm_squared())
+            .sum::<f64>()
+            / 8.0;
         let dv = me.com_velocity_change_m_s.unwrap_or_default();
         let mut c = vec![
             self.id.clone(),
@@ -124,7 +130,7 @@ impl Row {
         }
         for x in [
             v_err.sqrt(),
-            k.sigma_pos_m,
+            self.m.sigma_pos_m,
             me.v_n_m_s,
             self.m.v_n_err_m_s,
             me.e,
@@ -178,14 +184,32 @@ pub fn run(args: Args) -> CliResult {
     };
     let tracks = read_tracks(&args.path).map_err(|e| e.to_string())?;
     let shown = args.path.display().to_string();
-    let mut rows = Vec::new();
-    let mut records = Vec::new();
+    // Two passes: the position noise is one camera's, so the residuals of all collisions are
+    // pooled into one estimate (a 10-frame fit alone estimates it poorly), then every error uses it.
+    let place = |t: &restitution::data::tracks::CollisionTrack| {
+        format!("{shown}:{}: collision '{}'", t.first_line, t.id)
+    };
+    let mut splits = Vec::new();
+    let (mut rss, mut dof) = (0.0, 0usize);
     for t in &tracks {
-        let place = format!("{shown}:{}: collision '{}'", t.first_line, t.id);
         let split = match t.split {
             Some(s) => s,
-            None => split_at_contact(&t.frames, kind).map_err(|e| format!("{place}: {e}"))?,
+            None => split_at_contact(&t.frames, kind).map_err(|e| format!("{}: {e}", place(t)))?,
         };
+        let k = analyse(&t.frames, split, t.d1_m, t.d2_m, kind)
+            .map_err(|e| format!("{}: {e}", place(t)))?;
+        rss += k.rss_m2;
+        dof += k.dof;
+        splits.push(split);
+    }
+    let sigma = if dof > 0 {
+        (rss / dof as f64).sqrt()
+    } else {
+        eq8.s_subpixels * eq8.subpixel_m
+    };
+    let mut rows = Vec::new();
+    let mut records = Vec::new();
+    for (t, &split) in tracks.iter().zip(&splits) {
         let m = measure_collision(
             &t.frames,
             split,
@@ -196,8 +220,9 @@ pub fn run(args: Args) -> CliResult {
             t.spins_rad_s.unwrap_or([0.0; 4]),
             kind,
             &eq8,
+            Some(sigma),
         )
-        .map_err(|e| format!("{place}: {e}"))?;
+        .map_err(|e| format!("{}: {e}", place(t)))?;
         records.push(CollisionRecord {
             line: t.first_line,
             id: Some(t.id.clone()),
@@ -333,7 +358,9 @@ pub fn run(args: Args) -> CliResult {
                 );
             }
             println!(
-                "(speeds m/s; e_err from the fits' covariance, e_eq8 from Eq. 8 with s = {} subpixels of {} m; dv: momentum check)",
+                "(speeds m/s; e_err from the fits' covariance with the position noise pooled over all collisions: {} m = {:.2} subpixels; e_eq8 from Eq. 8 with s = {} subpixels of {} m; dv: momentum check)",
+                fmt_num(sigma),
+                sigma / subpixel_m,
                 fmt_num(args.s_subpixels),
                 fmt_num(subpixel_m)
             );
