@@ -203,6 +203,10 @@ impl TimeRule {
 /// Velocities of both spheres before and after, at the collision time, with standard errors.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Kinematics {
+    /// Where the collision time is searched: last pre frame - dt .. first post frame + dt.
+    pub window_s: (f64, f64),
+    /// Centre distance at contact, (d1 + d2)/2, m.
+    pub contact_m: f64,
     pub t_c_s: f64,
     pub time_rule: TimeRule,
     /// Centres at t_c from the pre-collision fits.
@@ -212,8 +216,6 @@ pub struct Kinematics {
     pub v_m_s: [Vector2<f64>; 4],
     /// Variance of each velocity component per unit position-noise variance, same order.
     pub v_var_factor_per_m2: [Vector2<f64>; 4],
-    /// Variance of the centres' coordinates at t_c (pre fits) per unit noise variance: [r1, r2].
-    pub r_var_factor: [Vector2<f64>; 2],
     /// Sum of squared residuals over the eight fits, m^2, and its degrees of freedom.
     pub rss_m2: f64,
     pub dof: usize,
@@ -286,18 +288,9 @@ pub fn analyse(
     } else {
         0.0
     };
-    let (lo, hi) = (pre.t_last_s - dt, post.t_first_s + dt);
+    let window = (pre.t_last_s - dt, post.t_first_s + dt);
     let contact = 0.5 * (d1_m + d2_m);
-    let gap = |t: f64| (pre.position(0, t) - pre.position(1, t)).norm() - contact;
-    let mismatch = |t: f64| {
-        (0..2)
-            .map(|s| (pre.position(s, t) - post.position(s, t)).norm_squared())
-            .sum::<f64>()
-    };
-    let (t_c, rule) = match first_crossing(&gap, lo, hi) {
-        Some(t) => (t, TimeRule::ContactDistance),
-        None => (argmin_scan(&mismatch, lo, hi), TimeRule::FitsMeet),
-    };
+    let (t_c, rule) = collision_time(&pre, &post, contact, window, None);
     let all = pre.fits.iter().chain(post.fits.iter());
     let (rss, dof) = all.fold((0.0, 0usize), |(r, d), f| (r + f.rss, d + f.n - need));
     let v = [
@@ -313,18 +306,14 @@ pub fn analyse(
         post.velocity_var_factor(1, t_c),
     ];
     Ok(Kinematics {
+        window_s: window,
+        contact_m: contact,
         t_c_s: t_c,
         time_rule: rule,
         r1_m: pre.position(0, t_c),
         r2_m: pre.position(1, t_c),
         v_m_s: v,
         v_var_factor_per_m2: factor,
-        r_var_factor: [0, 1].map(|s| {
-            Vector2::new(
-                pre.fits[2 * s].value_variance_factor(t_c),
-                pre.fits[2 * s + 1].value_variance_factor(t_c),
-            )
-        }),
         rss_m2: rss,
         dof,
         n_pre: pre_frames.len(),
@@ -332,6 +321,89 @@ pub fn analyse(
         pre,
         post,
     })
+}
+
+/// The collision time on `window` by `rule` (or the primary rule with its fallback when `None`).
+fn collision_time(
+    pre: &PhaseFit,
+    post: &PhaseFit,
+    contact_m: f64,
+    window: (f64, f64),
+    rule: Option<TimeRule>,
+) -> (f64, TimeRule) {
+    let (lo, hi) = window;
+    let gap = |t: f64| (pre.position(0, t) - pre.position(1, t)).norm() - contact_m;
+    let mismatch = |t: f64| {
+        (0..2)
+            .map(|s| (pre.position(s, t) - post.position(s, t)).norm_squared())
+            .sum::<f64>()
+    };
+    let crossing = match rule {
+        Some(TimeRule::FitsMeet) => None,
+        _ => first_crossing(&gap, lo, hi),
+    };
+    match crossing {
+        Some(t) => (t, TimeRule::ContactDistance),
+        None => (argmin_scan(&mismatch, lo, hi), TimeRule::FitsMeet),
+    }
+}
+
+/// (e, v_n) of the fits: the normal from the pre-collision centres at t_c, e = -(v1' - v2').n /
+/// (v1 - v2).n, v_n = -(v1 - v2).n. The same numbers [`walton::measure`] gives (spins do not
+/// enter the normal components); used here to propagate the fits' covariance.
+fn normal_restitution(pre: &PhaseFit, post: &PhaseFit, t_c: f64) -> (f64, f64) {
+    let n = (pre.position(0, t_c) - pre.position(1, t_c)).normalize();
+    let b = (pre.velocity(0, t_c) - pre.velocity(1, t_c)).dot(&n);
+    let a = (post.velocity(0, t_c) - post.velocity(1, t_c)).dot(&n);
+    (-a / b, -b)
+}
+
+/// Standard errors of (e, v_n) by linear propagation of every fit parameter's covariance
+/// (sigma^2 (X^T X)^-1 per fit; fits independent) through the whole chain, collision time and
+/// normal included, with central differences of step 1e-4 standard deviations.
+fn propagate(k: &Kinematics, sigma: f64) -> (f64, f64) {
+    let eval = |pre: &PhaseFit, post: &PhaseFit| {
+        let (t_c, _) = collision_time(pre, post, k.contact_m, k.window_s, Some(k.time_rule));
+        normal_restitution(pre, post, t_c)
+    };
+    let (mut var_e, mut var_vn) = (0.0, 0.0);
+    for phase in 0..2 {
+        for f in 0..4 {
+            let fit = if phase == 0 {
+                &k.pre.fits[f]
+            } else {
+                &k.post.fits[f]
+            };
+            let p = fit.xtx_inv.nrows();
+            let mut grad = vec![(0.0, 0.0); p];
+            for (j, g) in grad.iter_mut().enumerate() {
+                let h = 1e-4 * sigma * fit.xtx_inv[(j, j)].sqrt();
+                let shifted = |delta: f64| {
+                    let (mut pre, mut post) = (k.pre.clone(), k.post.clone());
+                    let target = if phase == 0 {
+                        &mut pre.fits[f]
+                    } else {
+                        &mut post.fits[f]
+                    };
+                    target.coef[j] += delta;
+                    eval(&pre, &post)
+                };
+                let (plus, minus) = (shifted(h), shifted(-h));
+                *g = (
+                    (plus.0 - minus.0) / (2.0 * h),
+                    (plus.1 - minus.1) / (2.0 * h),
+                );
+            }
+            for a in 0..p {
+                for b in 0..p {
+                    let c = sigma * sigma * fit.xtx_inv[(a, b)];
+                    var_e += grad[a].0 * c * grad[b].0;
+                    var_vn += grad[a].1 * c * grad[b].1;
+                }
+            }
+        }
+    }
+    (var_e.sqrt(), var_vn.sqrt())
 }
 
 /// First crossing of f from > 0 to <= 0 on [lo, hi], by a scan and bisection to rounding.
@@ -417,10 +489,10 @@ pub struct Measurement {
     pub sigma_pos_m: f64,
     /// Standard errors of each velocity component: [1 pre, 2 pre, 1 post, 2 post], m/s.
     pub v_err_m_s: [Vector2<f64>; 4],
-    /// Standard error of e from the fits' covariance: e = -(v1' - v2').n / (v1 - v2).n with the
-    /// eight velocity components independent, plus the error of the normal's direction from the
-    /// centres' positions and the collision time (de/dtheta = -(dv'.t + e dv.t)/(dv.n); both
-    /// large for grazing impacts).
+    /// Standard error of e from the fits' covariance, propagated through the whole chain: the
+    /// velocities, and the normal's direction through the centres and the collision time (a
+    /// position error along n shifts t_c by delta/v_n, while r1 - r2 turns at v_t/|r1 - r2|:
+    /// for grazing impacts this dominates).
     pub e_err: f64,
     /// Standard error of v_n from the fits' covariance, m/s.
     pub v_n_err_m_s: f64,
@@ -473,31 +545,8 @@ pub fn measure_collision(
         body(d2_m, k.r2_m, k.v_m_s[3], spins_rad_s[3])?,
     );
     let measured = walton::measure(&pre, &post)?;
-    let n = (k.r1_m - k.r2_m).normalize();
-    let var_n = |i: usize| n.x * n.x * v_err[i].x.powi(2) + n.y * n.y * v_err[i].y.powi(2);
-    let b = (k.v_m_s[0] - k.v_m_s[1]).dot(&n);
+    let (e_err, v_n_err) = propagate(&k, sigma);
     let e = measured.e;
-    let t_hat = Vector2::new(-n.y, n.x);
-    let var_along = |i: usize, u: &Vector2<f64>| {
-        let f = k.r_var_factor[i];
-        (u.x * u.x * f.x + u.y * u.y * f.y) * sigma * sigma
-    };
-    // The normal is the direction of r1 - r2 when |r1 - r2| = (d1 + d2)/2. A position error
-    // along n shifts that instant by delta/v_n, during which r1 - r2 turns at v_t/|r1 - r2|; an
-    // error across n turns it directly. Both matter most for grazing impacts.
-    let rel_v = k.v_m_s[0] - k.v_m_s[1];
-    let turn = rel_v.dot(&t_hat) / rel_v.dot(&n);
-    let var_theta = (var_along(0, &t_hat)
-        + var_along(1, &t_hat)
-        + turn * turn * (var_along(0, &n) + var_along(1, &n)))
-        / (k.r1_m - k.r2_m).norm_squared();
-    let dv_post_t = (k.v_m_s[2] - k.v_m_s[3]).dot(&t_hat);
-    let dv_pre_t = (k.v_m_s[0] - k.v_m_s[1]).dot(&t_hat);
-    let de_dtheta = -(dv_post_t + measured.e * dv_pre_t) / b;
-    let e_err = ((e * e * (var_n(0) + var_n(1)) + var_n(2) + var_n(3)) / (b * b)
-        + de_dtheta * de_dtheta * var_theta)
-        .sqrt();
-    let v_n_err = (var_n(0) + var_n(1)).sqrt();
     let dt = frames
         .windows(2)
         .map(|w| w[1].t_s - w[0].t_s)

@@ -63,6 +63,9 @@ pub struct Args {
     subpixel_expansion: f64,
     #[arg(long, value_enum, default_value = "table")]
     format: Format,
+    /// Stop at the first collision that cannot be measured instead of skipping it
+    #[arg(long)]
+    strict: bool,
     /// Write kinematics.csv, fit_input.csv and walton_input.csv here
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -191,16 +194,27 @@ pub fn run(args: Args) -> CliResult {
     };
     let mut splits = Vec::new();
     let (mut rss, mut dof) = (0.0, 0usize);
+    // A collision that cannot be measured (too few frames, receding spheres) is skipped with a
+    // warning naming it, so one bad track does not lose a campaign; --strict makes it an error.
+    let mut skipped = Vec::new();
     for t in &tracks {
-        let split = match t.split {
-            Some(s) => s,
-            None => split_at_contact(&t.frames, kind).map_err(|e| format!("{}: {e}", place(t)))?,
-        };
-        let k = analyse(&t.frames, split, t.d1_m, t.d2_m, kind)
-            .map_err(|e| format!("{}: {e}", place(t)))?;
-        rss += k.rss_m2;
-        dof += k.dof;
-        splits.push(split);
+        let split = t
+            .split
+            .map(Ok)
+            .unwrap_or_else(|| split_at_contact(&t.frames, kind));
+        match split
+            .and_then(|split| analyse(&t.frames, split, t.d1_m, t.d2_m, kind).map(|k| (split, k)))
+        {
+            Ok((split, k)) => {
+                rss += k.rss_m2;
+                dof += k.dof;
+                splits.push(Some(split));
+            }
+            Err(e) => {
+                skipped.push(format!("{}: {e}", place(t)));
+                splits.push(None);
+            }
+        }
     }
     let sigma = if dof > 0 {
         (rss / dof as f64).sqrt()
@@ -209,8 +223,9 @@ pub fn run(args: Args) -> CliResult {
     };
     let mut rows = Vec::new();
     let mut records = Vec::new();
-    for (t, &split) in tracks.iter().zip(&splits) {
-        let m = measure_collision(
+    for (t, split) in tracks.iter().zip(&splits) {
+        let Some(split) = *split else { continue };
+        let m = match measure_collision(
             &t.frames,
             split,
             t.d1_m,
@@ -221,8 +236,13 @@ pub fn run(args: Args) -> CliResult {
             kind,
             &eq8,
             Some(sigma),
-        )
-        .map_err(|e| format!("{}: {e}", place(t)))?;
+        ) {
+            Ok(m) => m,
+            Err(e) => {
+                skipped.push(format!("{}: {e}", place(t)));
+                continue;
+            }
+        };
         records.push(CollisionRecord {
             line: t.first_line,
             id: Some(t.id.clone()),
@@ -235,6 +255,14 @@ pub fn run(args: Args) -> CliResult {
             d2_mm: t.d2_m * 1e3,
             m,
         });
+    }
+    if !skipped.is_empty() {
+        if args.strict || rows.is_empty() {
+            return Err(skipped.swap_remove(0));
+        }
+        for s in &skipped {
+            eprintln!("restitution: warning: skipped {s}");
+        }
     }
     let fallbacks: Vec<&str> = rows
         .iter()
