@@ -8,7 +8,7 @@
 
 use crate::contact::{Material, Sphere};
 use crate::error::{Error, Result};
-use crate::kinematics::Frame;
+use crate::kinematics::{FitKind, Frame, measure_e};
 use crate::models::walton::{self, Body, ContactKind, State, WaltonParams};
 use nalgebra::{Vector2, Vector3};
 use rand::Rng;
@@ -288,6 +288,79 @@ pub fn simulate(
             split,
             spins_measured_rad_s: spins,
         });
+    }
+    Ok(out)
+}
+
+/// One point of a camera study: how well a camera measures e at one normal speed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StudyPoint {
+    pub camera: String,
+    pub fit: &'static str,
+    pub v_n_m_s: f64,
+    /// Collisions simulated and measured (the rest had too few frames for the fit).
+    pub simulated: usize,
+    pub measured: usize,
+    /// Mean and standard deviation of e_measured/e_true - 1 over the measured collisions.
+    pub bias: f64,
+    pub scatter: f64,
+}
+
+/// Monte Carlo of the measurement chain: for each camera and normal speed, simulate
+/// `per_point` collisions of `base` (the speed range collapsed to that speed), measure e from the
+/// tracks with free and fixed-gravity fits, and report the relative bias and scatter of e.
+pub fn camera_study(
+    base: &ExperimentSpec,
+    cameras: &[(String, Camera)],
+    v_n_m_s: &[f64],
+    per_point: usize,
+    e_of_v_n: &dyn Fn(f64) -> Result<f64>,
+    rng: &mut impl Rng,
+) -> Result<Vec<StudyPoint>> {
+    let kinds = [
+        ("free", FitKind::Free),
+        (
+            "fixed_gravity",
+            FitKind::FixedGravity {
+                g_m_s2: base.g_m_s2,
+            },
+        ),
+    ];
+    let mut out = Vec::new();
+    for (label, camera) in cameras {
+        for &v in v_n_m_s {
+            let spec = ExperimentSpec {
+                n: per_point,
+                v_n_range_m_s: (v, v),
+                camera: *camera,
+                ..*base
+            };
+            let sims = simulate(&spec, e_of_v_n, rng)?;
+            for (fit, kind) in kinds {
+                let rel: Vec<f64> = sims
+                    .iter()
+                    .filter_map(|s| {
+                        measure_e(&s.frames, s.split, spec.d1_m, spec.d2_m, kind)
+                            .ok()
+                            .map(|(e, _)| e / s.e - 1.0)
+                    })
+                    .filter(|x| x.is_finite())
+                    .collect();
+                let m = rel.len() as f64;
+                let bias = rel.iter().sum::<f64>() / m;
+                let scatter =
+                    (rel.iter().map(|x| (x - bias).powi(2)).sum::<f64>() / (m - 1.0)).sqrt();
+                out.push(StudyPoint {
+                    camera: label.clone(),
+                    fit,
+                    v_n_m_s: v,
+                    simulated: sims.len(),
+                    measured: rel.len(),
+                    bias: if rel.len() >= 2 { bias } else { f64::NAN },
+                    scatter: if rel.len() >= 2 { scatter } else { f64::NAN },
+                });
+            }
+        }
     }
     Ok(out)
 }

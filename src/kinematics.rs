@@ -468,6 +468,19 @@ pub fn eq8_velocity_error_m_s(
     s_subpixels * subpixel_m / (dt_s * (n_frames as f64).sqrt())
 }
 
+/// e and v_n of one collision from its tracks, without error propagation (for Monte Carlo
+/// studies, where the scatter over repetitions is the error).
+pub fn measure_e(
+    frames: &[Frame],
+    split: usize,
+    d1_m: f64,
+    d2_m: f64,
+    kind: FitKind,
+) -> Result<(f64, f64)> {
+    let k = analyse(frames, split, d1_m, d2_m, kind)?;
+    Ok(normal_restitution(&k.pre, &k.post, k.t_c_s))
+}
+
 /// The camera numbers Eq. (8) needs besides the frame interval and count.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Eq8Inputs {

@@ -21,7 +21,7 @@ use rand::rngs::StdRng;
 use restitution::contact::Pair;
 use restitution::data::tracks::{CollisionTrack, write_tracks};
 use restitution::data::{fmt_num, write_all_atomic};
-use restitution::experiment::{Camera, ExperimentSpec, simulate};
+use restitution::experiment::{Camera, ExperimentSpec, camera_study, simulate};
 use restitution::fit::models::{ModelKind, predict_e};
 use restitution::models::viscoelastic::{ContactEnd, VmMethod};
 use restitution::models::walton::Target;
@@ -65,10 +65,10 @@ pub struct Args {
     #[arg(long, default_value_t = 0.5)]
     beta0: f64,
     /// Range of the normal impact speed, m/s (log-uniform)
-    #[arg(long = "v-n-m-s", value_delimiter = ',', num_args = 2, default_values_t = [0.5, 5.0])]
+    #[arg(long = "v-n-m-s", value_delimiter = ',', default_values_t = [0.5, 5.0])]
     v_n_m_s: Vec<f64>,
     /// Range of the angle of incidence, degrees (0 = head-on)
-    #[arg(long = "incidence-deg", value_delimiter = ',', num_args = 2, default_values_t = [0.0, 80.0])]
+    #[arg(long = "incidence-deg", value_delimiter = ',', default_values_t = [0.0, 80.0])]
     incidence_deg: Vec<f64>,
     /// Camera frame rate, 1/s
     #[arg(long, default_value_t = Camera::PAPER.frames_per_s)]
@@ -86,11 +86,20 @@ pub struct Args {
     #[arg(long = "s-subpixels", default_value_t = Camera::PAPER.s_subpixels)]
     s_subpixels: f64,
     /// Frames per phase, drawn in this range (fewer when fast, never below 2)
-    #[arg(long, value_delimiter = ',', num_args = 2, default_values_t = [8usize, 12])]
+    #[arg(long, value_delimiter = ',', default_values_t = [8usize, 12])]
     frames: Vec<usize>,
     /// Error of spins measured from markers, rad/s
     #[arg(long = "spin-noise-rad-s", default_value_t = 3.0)]
     spin_noise_rad_s: f64,
+    /// Instead of tracks: a Monte Carlo of the measured e's bias and scatter against v_n for
+    /// this camera and three better ones (camera_study.csv, camera_study.svg); faster cameras
+    /// film the same time window, in proportionally more frames; faster cameras
+    /// film the same time window, in proportionally more frames
+    #[arg(long = "camera-study")]
+    camera_study: bool,
+    /// Collisions per camera and speed in the camera study
+    #[arg(long = "study-n", default_value_t = 200)]
+    study_n: usize,
 }
 
 fn parse_model(s: &str) -> Result<ModelKind, String> {
@@ -115,6 +124,15 @@ fn check(flag: &str, v: f64, ok: bool, expected: &str) -> CliResult {
 }
 
 pub fn run(args: Args) -> CliResult {
+    for (flag, n) in [
+        ("--v-n-m-s", args.v_n_m_s.len()),
+        ("--incidence-deg", args.incidence_deg.len()),
+        ("--frames", args.frames.len()),
+    ] {
+        if n != 2 {
+            return Err(format!("{flag}: expected two values MIN,MAX, got {n}"));
+        }
+    }
     let material = args.material.resolve()?;
     check("--d-mm", args.d_mm, args.d_mm > 0.0, "a diameter > 0 (mm)")?;
     let d2_mm = args.d2_mm.unwrap_or(args.d_mm);
@@ -209,6 +227,9 @@ pub fn run(args: Args) -> CliResult {
         )
     };
     let mut rng = StdRng::seed_from_u64(args.seed);
+    if args.camera_study {
+        return study(&args, &spec, &e_of, &mut rng);
+    }
     let sims = simulate(&spec, &e_of, &mut rng).map_err(|e| e.to_string())?;
 
     let tracks: Vec<CollisionTrack> = sims
@@ -294,6 +315,90 @@ pub fn run(args: Args) -> CliResult {
         sims.len(),
         frames,
         fmt_num(camera.sigma_m()),
+        args.out.display()
+    );
+    Ok(())
+}
+
+/// The camera study: this camera, twice the frame rate, four times the pixels, and both better.
+fn study(
+    args: &Args,
+    spec: &ExperimentSpec,
+    e_of: &dyn Fn(f64) -> restitution::Result<f64>,
+    rng: &mut StdRng,
+) -> CliResult {
+    let c = spec.camera;
+    // A faster camera films the same time window in more frames (the field of view, not the frame
+    // count, limits a phase); with the frame count fixed it would see a shorter window and
+    // measure slopes worse, not better.
+    let fps = |k: f64| Camera {
+        frames_per_s: c.frames_per_s * k,
+        frames_min: (c.frames_min as f64 * k).round() as usize,
+        frames_max: (c.frames_max as f64 * k).round() as usize,
+        ..c
+    };
+    let px = |k: u32, cam: Camera| Camera {
+        pixels_x: cam.pixels_x * k,
+        pixels_y: cam.pixels_y * k,
+        ..cam
+    };
+    let cameras = vec![
+        (
+            format!("{} fps, {} px", fmt_num(c.frames_per_s), c.pixels_x),
+            c,
+        ),
+        (
+            format!("{} fps, {} px", fmt_num(2.0 * c.frames_per_s), c.pixels_x),
+            fps(2.0),
+        ),
+        (
+            format!("{} fps, {} px", fmt_num(c.frames_per_s), 4 * c.pixels_x),
+            px(4, c),
+        ),
+        (
+            format!(
+                "{} fps, {} px",
+                fmt_num(5.0 * c.frames_per_s),
+                4 * c.pixels_x
+            ),
+            px(4, fps(5.0)),
+        ),
+    ];
+    let speeds = [0.3, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0];
+    let points = camera_study(spec, &cameras, &speeds, args.study_n, e_of, rng)
+        .map_err(|e| e.to_string())?;
+    let mut csv = String::from("camera,fit,v_n_m_s,simulated,measured,bias,scatter\n");
+    for p in &points {
+        csv += &format!(
+            "{},{},{},{},{},{},{}\n",
+            p.camera,
+            p.fit,
+            fmt_num(p.v_n_m_s),
+            p.simulated,
+            p.measured,
+            fmt_num(p.bias),
+            fmt_num(p.scatter)
+        );
+    }
+    let title = format!(
+        "Measured e against true e: {} mm {}, s = {} subpixels, {}-{} frames per phase at the base rate",
+        fmt_num(args.d_mm),
+        args.material.material.as_deref().unwrap_or("spheres"),
+        fmt_num(c.s_subpixels),
+        c.frames_min,
+        c.frames_max
+    );
+    let svg = restitution::plot::kinematics::camera_study_svg(&points, &title)?;
+    std::fs::create_dir_all(&args.out)
+        .map_err(|e| format!("{}: cannot create: {e}", args.out.display()))?;
+    write_all_atomic(&[
+        (args.out.join("camera_study.csv"), csv.into_bytes()),
+        (args.out.join("camera_study.svg"), svg.into_bytes()),
+    ])
+    .map_err(|e| format!("{}: cannot write: {e}", args.out.display()))?;
+    println!(
+        "camera study: {} points -> {}/camera_study.csv, camera_study.svg",
+        points.len(),
         args.out.display()
     );
     Ok(())

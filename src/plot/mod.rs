@@ -4,4 +4,5 @@
 //! plotters' SVG font sizes come out smaller than asked, so sizes here are chosen by looking at
 //! the rendered figures, not by the nominal point size.
 pub mod fit;
+pub mod kinematics;
 pub mod walton;
