@@ -344,15 +344,15 @@ fn study(
     };
     let cameras = vec![
         (
-            format!("{} fps, {} px", fmt_num(c.frames_per_s), c.pixels_x),
+            format!("{} fps / {} px", fmt_num(c.frames_per_s), c.pixels_x),
             c,
         ),
         (
-            format!("{} fps, {} px", fmt_num(2.0 * c.frames_per_s), c.pixels_x),
+            format!("{} fps / {} px", fmt_num(2.0 * c.frames_per_s), c.pixels_x),
             fps(2.0),
         ),
         (
-            format!("{} fps, {} px", fmt_num(c.frames_per_s), 4 * c.pixels_x),
+            format!("{} fps / {} px", fmt_num(c.frames_per_s), 4 * c.pixels_x),
             px(4, c),
         ),
         (
