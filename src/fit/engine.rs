@@ -582,7 +582,9 @@ fn profile_intervals(
         };
         let mut sides = [None, None];
         for (s, limit) in [obj.lower[j], obj.upper[j]].into_iter().enumerate() {
-            let warm = std::cell::RefCell::new(theta.clone());
+            // Warm starts: the inner minimum at the nearest profile point already computed, so
+            // the profile follows one valley continuously.
+            let warm = std::cell::RefCell::new(vec![(theta[j], theta.clone())]);
             let lower_found = std::cell::RefCell::new(None::<Vec<f64>>);
             let profile = |t: f64| -> Result<f64> {
                 if k == 1 {
@@ -592,7 +594,12 @@ fn profile_intervals(
                     }
                     return Ok(c);
                 }
-                let mut start = warm.borrow().clone();
+                let mut start = warm
+                    .borrow()
+                    .iter()
+                    .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
+                    .map(|(_, th)| th.clone())
+                    .unwrap_or_else(|| theta.clone());
                 start[j] = t;
                 let mut free = vec![true; k];
                 free[j] = false;
@@ -600,7 +607,7 @@ fn profile_intervals(
                 if r.chi2 < beaten {
                     *lower_found.borrow_mut() = Some(r.theta.clone());
                 }
-                *warm.borrow_mut() = r.theta;
+                warm.borrow_mut().push((t, r.theta));
                 Ok(r.chi2)
             };
             sides[s] = lsq::profile_crossing(profile, theta[j], limit, step, threshold, 1e-7)?;
