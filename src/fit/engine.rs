@@ -733,6 +733,13 @@ fn summarise(
     if !best.converged {
         notes.push(format!("the minimiser did not converge ({})", best.reason));
     }
+    if !data.weighted {
+        notes.push(
+            "unweighted (no e_err or v_err_m_s): chi2 is the residual sum of squares, and the \
+             errors come from the scatter alone"
+                .into(),
+        );
+    }
     let derived = derive(data, &params);
     Ok(FitResult {
         model: kind,
@@ -811,16 +818,15 @@ fn derive(data: &FitData, params: &[ParamEstimate]) -> Vec<ParamEstimate> {
 pub struct FitSet {
     pub fits: Vec<FitResult>,
     pub comparison: Option<super::compare::Comparison>,
+    /// Models not fitted because the data have no more points than the model has parameters.
+    pub skipped: Vec<ModelKind>,
 }
 
 /// Fits each model in `kinds` (skipping those with as many parameters as points, with an error
-/// if none is left) and compares them when there are two or more.
+/// if none is left), one thread per model, and compares them when there are two or more.
 pub fn fit_all(data: &FitData, kinds: &[ModelKind], options: &FitOptions) -> Result<FitSet> {
-    let kinds: Vec<ModelKind> = kinds
-        .iter()
-        .copied()
-        .filter(|k| data.len() > k.n_params())
-        .collect();
+    let (kinds, skipped): (Vec<ModelKind>, Vec<ModelKind>) =
+        kinds.iter().partition(|k| data.len() > k.n_params());
     if kinds.is_empty() {
         return Err(Error::InvalidParameter {
             name: "number of data points",
@@ -828,10 +834,22 @@ pub fn fit_all(data: &FitData, kinds: &[ModelKind], options: &FitOptions) -> Res
             expected: "more points than the model has parameters",
         });
     }
-    let fits = kinds
-        .iter()
-        .map(|&k| fit(data, k, options))
-        .collect::<Result<Vec<_>>>()?;
+    // The models are independent: fit them on separate threads (results do not depend on the
+    // number of threads; each fit is deterministic).
+    let fits = std::thread::scope(|s| {
+        let handles: Vec<_> = kinds
+            .iter()
+            .map(|&k| s.spawn(move || fit(data, k, options)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("a fit thread panicked"))
+            .collect::<Result<Vec<_>>>()
+    })?;
     let comparison = (fits.len() >= 2).then(|| super::compare::compare(&fits));
-    Ok(FitSet { fits, comparison })
+    Ok(FitSet {
+        fits,
+        comparison,
+        skipped,
+    })
 }

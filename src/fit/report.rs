@@ -148,6 +148,7 @@ pub fn to_json(ctx: &ReportContext, set: &FitSet) -> Value {
         "comparison": comparison,
         "preferred": preferred,
         "preferred_rule": PREFERENCE_RULE,
+        "skipped_models": set.skipped.iter().map(|k| k.name()).collect::<Vec<_>>(),
     })
 }
 
@@ -317,6 +318,9 @@ fn short(x: f64, digits: usize) -> String {
     if !x.is_finite() {
         return "-".into();
     }
+    if x == 0.0 {
+        return "0".into();
+    }
     let a = x.abs();
     if a != 0.0 && !(1e-3..1e6).contains(&a) {
         format!("{x:.prec$e}", prec = digits.saturating_sub(1))
@@ -443,6 +447,14 @@ fn preferred_line(set: &FitSet) -> Option<String> {
 
 fn note_lines(set: &FitSet) -> Vec<String> {
     let mut out = Vec::new();
+    for k in &set.skipped {
+        out.push(format!(
+            "{}: not fitted: {} parameters need more than {} points",
+            k.name(),
+            k.n_params(),
+            set.fits.first().map_or(0, |f| f.n)
+        ));
+    }
     for f in &set.fits {
         for n in &f.notes {
             out.push(format!("{}: {n}", f.model.name()));
