@@ -698,11 +698,15 @@ fn summarise(
         if (theta[j] - obj.lower[j]).abs() < 1e-6 * span
             || (theta[j] - obj.upper[j]).abs() < 1e-6 * span
         {
+            let unit = if spec.unit == "1" {
+                String::new()
+            } else {
+                format!(" {}", spec.unit)
+            };
             notes.push(format!(
-                "{} ended at the edge of its search range ({} {})",
+                "{} ended at the edge of its search range ({}{unit})",
                 spec.key,
                 crate::data::fmt_num(phys[j]),
-                spec.unit
             ));
         }
     }

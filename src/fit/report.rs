@@ -214,7 +214,13 @@ struct Shown {
 }
 
 fn show_param(p: &ParamEstimate) -> Shown {
-    let style = Style::of(p.best_fit, p.stderr);
+    // A bound is shown at its own scale (the best fit of an undetermined parameter is arbitrary).
+    let anchor = match p.status {
+        ParamStatus::LowerBound => p.ci95.0.unwrap_or(p.best_fit),
+        ParamStatus::UpperBound => p.ci95.1.unwrap_or(p.best_fit),
+        _ => p.best_fit,
+    };
+    let style = Style::of(anchor, p.stderr);
     let o = |x: Option<f64>| x.map(|v| style.show(v)).unwrap_or_default();
     // An error in the value's power of ten, with at least two significant digits of its own.
     let err = |e: Option<f64>| {
