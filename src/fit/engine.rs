@@ -118,7 +118,8 @@ pub struct FitResult {
     pub model: ModelKind,
     pub params: Vec<ParamEstimate>,
     /// Quantities derived from the parameters: `A_s` (Brilliantov's A = 2 eta / E*, s) and
-    /// `v_yield_m_s` (V_Y of identical spheres, size-independent, Eq. 15).
+    /// `v_yield_m_s` (V_Y, Eq. 15, of the data's pair geometry when all points share one, as
+    /// identical spheres of any sizes do; else of identical spheres).
     pub derived: Vec<ParamEstimate>,
     /// Correlation matrix of the parameters (NaN where undetermined).
     pub correlation: Vec<Vec<f64>>,
@@ -803,9 +804,16 @@ fn derive(data: &FitData, params: &[ParamEstimate]) -> Vec<ParamEstimate> {
         out.push(map_param(eta, "A_s", "s", |x| c.brilliantov_a_s(x), 1.0));
     }
     if let Some(sy) = params.iter().find(|p| p.key == "sigma_y")
-        && let Ok(c) = pair_contact(data.material, 10.0, None)
+        && let Ok(identical) = pair_contact(data.material, 10.0, None)
     {
-        // V_Y of identical spheres does not depend on their size (Eq. 15); V_Y ~ sigma_y^(5/2).
+        // V_Y of the data's pairs when they all share one (identical spheres of any size do:
+        // Eq. 15 has no size in it); otherwise that of identical spheres. V_Y ~ sigma_y^(5/2).
+        let first = data.contacts[0].yield_velocity_m_s(1.0);
+        let shared = data
+            .contacts
+            .iter()
+            .all(|c| (c.yield_velocity_m_s(1.0) / first - 1.0).abs() < 1e-9);
+        let c = if shared { data.contacts[0] } else { identical };
         out.push(map_param(
             sy,
             "v_yield_m_s",
