@@ -118,7 +118,8 @@ pub struct FitResult {
     pub model: ModelKind,
     pub params: Vec<ParamEstimate>,
     /// Quantities derived from the parameters: `A_s` (Brilliantov's A = 2 eta / E*, s) and
-    /// `v_yield_m_s` (V_Y of identical spheres, size-independent, Eq. 15).
+    /// `v_yield_m_s` (V_Y, Eq. 15, of the data's pair geometry when all points share one, as
+    /// identical spheres of any sizes do; else of identical spheres).
     pub derived: Vec<ParamEstimate>,
     /// Correlation matrix of the parameters (NaN where undetermined).
     pub correlation: Vec<Vec<f64>>,
@@ -582,7 +583,9 @@ fn profile_intervals(
         };
         let mut sides = [None, None];
         for (s, limit) in [obj.lower[j], obj.upper[j]].into_iter().enumerate() {
-            let warm = std::cell::RefCell::new(theta.clone());
+            // Warm starts: the inner minimum at the nearest profile point already computed, so
+            // the profile follows one valley continuously.
+            let warm = std::cell::RefCell::new(vec![(theta[j], theta.clone())]);
             let lower_found = std::cell::RefCell::new(None::<Vec<f64>>);
             let profile = |t: f64| -> Result<f64> {
                 if k == 1 {
@@ -592,7 +595,12 @@ fn profile_intervals(
                     }
                     return Ok(c);
                 }
-                let mut start = warm.borrow().clone();
+                let mut start = warm
+                    .borrow()
+                    .iter()
+                    .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
+                    .map(|(_, th)| th.clone())
+                    .unwrap_or_else(|| theta.clone());
                 start[j] = t;
                 let mut free = vec![true; k];
                 free[j] = false;
@@ -600,7 +608,7 @@ fn profile_intervals(
                 if r.chi2 < beaten {
                     *lower_found.borrow_mut() = Some(r.theta.clone());
                 }
-                *warm.borrow_mut() = r.theta;
+                warm.borrow_mut().push((t, r.theta));
                 Ok(r.chi2)
             };
             sides[s] = lsq::profile_crossing(profile, theta[j], limit, step, threshold, 1e-7)?;
@@ -691,11 +699,15 @@ fn summarise(
         if (theta[j] - obj.lower[j]).abs() < 1e-6 * span
             || (theta[j] - obj.upper[j]).abs() < 1e-6 * span
         {
+            let unit = if spec.unit == "1" {
+                String::new()
+            } else {
+                format!(" {}", spec.unit)
+            };
             notes.push(format!(
-                "{} ended at the edge of its search range ({} {})",
+                "{} ended at the edge of its search range ({}{unit})",
                 spec.key,
                 crate::data::fmt_num(phys[j]),
-                spec.unit
             ));
         }
     }
@@ -725,6 +737,13 @@ fn summarise(
     };
     if !best.converged {
         notes.push(format!("the minimiser did not converge ({})", best.reason));
+    }
+    if !data.weighted {
+        notes.push(
+            "unweighted (no e_err or v_err_m_s): chi2 is the residual sum of squares, and the \
+             errors come from the scatter alone"
+                .into(),
+        );
     }
     let derived = derive(data, &params);
     Ok(FitResult {
@@ -785,9 +804,16 @@ fn derive(data: &FitData, params: &[ParamEstimate]) -> Vec<ParamEstimate> {
         out.push(map_param(eta, "A_s", "s", |x| c.brilliantov_a_s(x), 1.0));
     }
     if let Some(sy) = params.iter().find(|p| p.key == "sigma_y")
-        && let Ok(c) = pair_contact(data.material, 10.0, None)
+        && let Ok(identical) = pair_contact(data.material, 10.0, None)
     {
-        // V_Y of identical spheres does not depend on their size (Eq. 15); V_Y ~ sigma_y^(5/2).
+        // V_Y of the data's pairs when they all share one (identical spheres of any size do:
+        // Eq. 15 has no size in it); otherwise that of identical spheres. V_Y ~ sigma_y^(5/2).
+        let first = data.contacts[0].yield_velocity_m_s(1.0);
+        let shared = data
+            .contacts
+            .iter()
+            .all(|c| (c.yield_velocity_m_s(1.0) / first - 1.0).abs() < 1e-9);
+        let c = if shared { data.contacts[0] } else { identical };
         out.push(map_param(
             sy,
             "v_yield_m_s",
@@ -804,16 +830,15 @@ fn derive(data: &FitData, params: &[ParamEstimate]) -> Vec<ParamEstimate> {
 pub struct FitSet {
     pub fits: Vec<FitResult>,
     pub comparison: Option<super::compare::Comparison>,
+    /// Models not fitted because the data have no more points than the model has parameters.
+    pub skipped: Vec<ModelKind>,
 }
 
 /// Fits each model in `kinds` (skipping those with as many parameters as points, with an error
-/// if none is left) and compares them when there are two or more.
+/// if none is left), one thread per model, and compares them when there are two or more.
 pub fn fit_all(data: &FitData, kinds: &[ModelKind], options: &FitOptions) -> Result<FitSet> {
-    let kinds: Vec<ModelKind> = kinds
-        .iter()
-        .copied()
-        .filter(|k| data.len() > k.n_params())
-        .collect();
+    let (kinds, skipped): (Vec<ModelKind>, Vec<ModelKind>) =
+        kinds.iter().partition(|k| data.len() > k.n_params());
     if kinds.is_empty() {
         return Err(Error::InvalidParameter {
             name: "number of data points",
@@ -821,10 +846,22 @@ pub fn fit_all(data: &FitData, kinds: &[ModelKind], options: &FitOptions) -> Res
             expected: "more points than the model has parameters",
         });
     }
-    let fits = kinds
-        .iter()
-        .map(|&k| fit(data, k, options))
-        .collect::<Result<Vec<_>>>()?;
+    // The models are independent: fit them on separate threads (results do not depend on the
+    // number of threads; each fit is deterministic).
+    let fits = std::thread::scope(|s| {
+        let handles: Vec<_> = kinds
+            .iter()
+            .map(|&k| s.spawn(move || fit(data, k, options)))
+            .collect();
+        handles
+            .into_iter()
+            .map(|h| h.join().expect("a fit thread panicked"))
+            .collect::<Result<Vec<_>>>()
+    })?;
     let comparison = (fits.len() >= 2).then(|| super::compare::compare(&fits));
-    Ok(FitSet { fits, comparison })
+    Ok(FitSet {
+        fits,
+        comparison,
+        skipped,
+    })
 }

@@ -449,8 +449,9 @@ pub fn profile_crossing(
         dist *= 2.0;
     };
     let failure = RefCell::new(None);
+    let shared = RefCell::new(&mut profile);
     let problem = Scalar {
-        f: RefCell::new(|t: f64| profile(t)),
+        f: RefCell::new(|t: f64| (shared.borrow_mut())(t)),
         failure: &failure,
         offset: threshold,
     };
@@ -464,7 +465,25 @@ pub fn profile_crossing(
         .run();
     match res {
         Ok(r) => Ok(r.state().get_best_param().copied().or(Some(outer))),
-        Err(_) => Err(solver_failure("profile root", failure.take())),
+        Err(_) => {
+            if let Some(e) = failure.take() {
+                return Err(e);
+            }
+            // A profile that re-minimises the other parameters need not return the same value
+            // when evaluated again at a bracket end (its inner minimisation may settle
+            // elsewhere), so Brent can find no sign change. Bisect instead, trusting the
+            // classification of each new point.
+            let (mut below, mut above) = (inner, outer);
+            while (above - below).abs() > tol {
+                let mid = 0.5 * (below + above);
+                if (shared.borrow_mut())(mid)? >= threshold {
+                    above = mid;
+                } else {
+                    below = mid;
+                }
+            }
+            Ok(Some(0.5 * (below + above)))
+        }
     }
 }
 

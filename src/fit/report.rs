@@ -148,6 +148,7 @@ pub fn to_json(ctx: &ReportContext, set: &FitSet) -> Value {
         "comparison": comparison,
         "preferred": preferred,
         "preferred_rule": PREFERENCE_RULE,
+        "skipped_models": set.skipped.iter().map(|k| k.name()).collect::<Vec<_>>(),
     })
 }
 
@@ -213,7 +214,13 @@ struct Shown {
 }
 
 fn show_param(p: &ParamEstimate) -> Shown {
-    let style = Style::of(p.best_fit, p.stderr);
+    // A bound is shown at its own scale (the best fit of an undetermined parameter is arbitrary).
+    let anchor = match p.status {
+        ParamStatus::LowerBound => p.ci95.0.unwrap_or(p.best_fit),
+        ParamStatus::UpperBound => p.ci95.1.unwrap_or(p.best_fit),
+        _ => p.best_fit,
+    };
+    let style = Style::of(anchor, p.stderr);
     let o = |x: Option<f64>| x.map(|v| style.show(v)).unwrap_or_default();
     // An error in the value's power of ten, with at least two significant digits of its own.
     let err = |e: Option<f64>| {
@@ -316,6 +323,9 @@ fn aligned(rows: &[Vec<String>], right: &[bool]) -> String {
 fn short(x: f64, digits: usize) -> String {
     if !x.is_finite() {
         return "-".into();
+    }
+    if x == 0.0 {
+        return "0".into();
     }
     let a = x.abs();
     if a != 0.0 && !(1e-3..1e6).contains(&a) {
@@ -443,6 +453,14 @@ fn preferred_line(set: &FitSet) -> Option<String> {
 
 fn note_lines(set: &FitSet) -> Vec<String> {
     let mut out = Vec::new();
+    for k in &set.skipped {
+        out.push(format!(
+            "{}: not fitted: {} parameters need more than {} points",
+            k.name(),
+            k.n_params(),
+            set.fits.first().map_or(0, |f| f.n)
+        ));
+    }
     for f in &set.fits {
         for n in &f.notes {
             out.push(format!("{}: {n}", f.model.name()));
