@@ -357,7 +357,7 @@ fn study(
         ),
         (
             format!(
-                "{} fps, {} px",
+                "{} fps / {} px",
                 fmt_num(5.0 * c.frames_per_s),
                 4 * c.pixels_x
             ),

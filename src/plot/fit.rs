@@ -10,19 +10,8 @@ use plotters::coord::Shift;
 use plotters::element::{Circle, Cross, EmptyElement, PathElement, Rectangle, TriangleMarker};
 use plotters::prelude::*;
 
-/// Okabe & Ito's colour-blind-safe palette (without black and yellow, which carry the models and
-/// vanish on white).
-const PALETTE: [RGBColor; 6] = [
-    RGBColor(0, 114, 178),
-    RGBColor(213, 94, 0),
-    RGBColor(0, 158, 115),
-    RGBColor(204, 121, 167),
-    RGBColor(230, 159, 0),
-    RGBColor(86, 180, 233),
-];
-
 fn colour(g: usize) -> RGBColor {
-    PALETTE[g % PALETTE.len()]
+    super::colour(g)
 }
 
 /// Draws points with group `g`'s marker: filled circle, triangle, square, cross, hollow circle,

@@ -4,15 +4,6 @@
 use crate::experiment::StudyPoint;
 use plotters::prelude::*;
 
-const COLOURS: [RGBColor; 6] = [
-    RGBColor(31, 119, 180),
-    RGBColor(214, 95, 14),
-    RGBColor(44, 160, 44),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-];
-
 /// Renders the camera study as an SVG string (two panels: scatter, bias).
 pub fn camera_study_svg(points: &[StudyPoint], title: &str) -> Result<String, String> {
     let mut cameras: Vec<&str> = Vec::new();
@@ -86,7 +77,7 @@ pub fn camera_study_svg(points: &[StudyPoint], title: &str) -> Result<String, St
         ))
         .map_err(e)?;
         for (i, cam) in cameras.iter().enumerate() {
-            let colour = COLOURS[i % COLOURS.len()];
+            let colour = super::colour(i);
             for fit in ["free", "fixed_gravity"] {
                 let series: Vec<&StudyPoint> = points
                     .iter()
