@@ -2,11 +2,15 @@
 //! modelled on the paper's apparatus (Sec. III: 1000 frames/s, 192 x 239 pixels, 4x subpixel
 //! expansion, centre accuracy s ~ 2 subpixels, 8 to 12 frames per phase, as few as 2 when fast).
 //!
-//! No physics of the collision lives here: the caller supplies the states at the collision
-//! instant; this module only films them.
+//! The collision itself is Walton's operator ([`crate::models::walton::collide`]) with e(v_n)
+//! supplied by the caller (any model of `fit::models`); this module draws the geometry, collides,
+//! and films the result.
 
-use crate::kinematics::Frame;
-use nalgebra::Vector2;
+use crate::contact::{Material, Sphere};
+use crate::error::{Error, Result};
+use crate::kinematics::{FitKind, Frame, measure_e};
+use crate::models::walton::{self, Body, ContactKind, State, WaltonParams};
+use nalgebra::{Vector2, Vector3};
 use rand::Rng;
 use rand_distr::{Distribution, Normal};
 
@@ -121,6 +125,244 @@ impl Scene {
         }
         (frames, n_pre)
     }
+}
+
+/// What the virtual experiment draws and how it collides.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ExperimentSpec {
+    pub n: usize,
+    pub d1_m: f64,
+    pub d2_m: f64,
+    pub material: Material,
+    pub inertia_k: f64,
+    /// Normal approach speed, drawn log-uniformly in this range, m/s.
+    pub v_n_range_m_s: (f64, f64),
+    /// Angle of incidence between -n and the relative velocity, uniform in this range, degrees.
+    pub incidence_deg: (f64, f64),
+    pub mu0: f64,
+    pub beta0: f64,
+    /// Spread of each component of the centre-of-mass velocity, m/s.
+    pub cm_speed_sd_m_s: f64,
+    /// Spread of the pre-collision spins, rad/s.
+    pub spin_sd_rad_s: f64,
+    /// Error of a spin measured from markers, rad/s.
+    pub spin_noise_rad_s: f64,
+    pub g_m_s2: f64,
+    pub camera: Camera,
+}
+
+impl ExperimentSpec {
+    /// The paper's set-up: 25.4 mm nylon spheres, Walton's mu_0 = 0.175 and beta_0 = 0.5,
+    /// impact speeds 0.5 to 5 m/s at incidences 0 to 80 degrees, the paper's camera.
+    pub fn paper() -> Self {
+        ExperimentSpec {
+            n: 60,
+            d1_m: 0.0254,
+            d2_m: 0.0254,
+            material: Material::preset("nylon").expect("a preset"),
+            inertia_k: walton::K_HOMOGENEOUS,
+            v_n_range_m_s: (0.5, 5.0),
+            incidence_deg: (0.0, 80.0),
+            mu0: 0.175,
+            beta0: 0.5,
+            cm_speed_sd_m_s: 0.3,
+            spin_sd_rad_s: 3.0,
+            spin_noise_rad_s: 3.0,
+            g_m_s2: crate::kinematics::G_STANDARD_M_S2,
+            camera: Camera::PAPER,
+        }
+    }
+}
+
+/// One simulated collision: the truth and what the camera saw.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Simulated {
+    pub id: String,
+    pub pre: State,
+    pub post: State,
+    pub e: f64,
+    pub v_n_m_s: f64,
+    pub beta: f64,
+    pub psi: f64,
+    pub kind: ContactKind,
+    pub frames: Vec<Frame>,
+    /// Index of the first post-collision frame.
+    pub split: usize,
+    /// Spins measured from markers: [1 pre, 2 pre, 1 post, 2 post], rad/s.
+    pub spins_measured_rad_s: [f64; 4],
+}
+
+/// Runs the virtual experiment: draws `spec.n` collisions, resolves each with Walton's operator
+/// and e = `e_of_v_n(v_n)`, and films them. Collision ids are `c1`, `c2`, ...
+pub fn simulate(
+    spec: &ExperimentSpec,
+    e_of_v_n: &dyn Fn(f64) -> Result<f64>,
+    rng: &mut impl Rng,
+) -> Result<Vec<Simulated>> {
+    let (lo, hi) = spec.v_n_range_m_s;
+    if !(lo > 0.0 && hi >= lo && hi.is_finite()) {
+        return Err(Error::InvalidParameter {
+            name: "v_n range (m/s)",
+            value: lo,
+            expected: "0 < min <= max",
+        });
+    }
+    let (g_lo, g_hi) = spec.incidence_deg;
+    if !(0.0..90.0).contains(&g_lo) || !(g_lo..90.0).contains(&g_hi) {
+        return Err(Error::InvalidParameter {
+            name: "incidence range (deg)",
+            value: g_hi,
+            expected: "0 <= min <= max < 90",
+        });
+    }
+    let s1 = Sphere::new(spec.d1_m, spec.material)?;
+    let s2 = Sphere::new(spec.d2_m, spec.material)?;
+    let (m1, m2) = (s1.mass_kg(), s2.mass_kg());
+    let cm = Normal::new(0.0, spec.cm_speed_sd_m_s).map_err(|_| Error::InvalidParameter {
+        name: "centre-of-mass speed spread (m/s)",
+        value: spec.cm_speed_sd_m_s,
+        expected: ">= 0",
+    })?;
+    let spin = Normal::new(0.0, spec.spin_sd_rad_s).map_err(|_| Error::InvalidParameter {
+        name: "spin spread (rad/s)",
+        value: spec.spin_sd_rad_s,
+        expected: ">= 0",
+    })?;
+    let spin_noise =
+        Normal::new(0.0, spec.spin_noise_rad_s).map_err(|_| Error::InvalidParameter {
+            name: "spin noise (rad/s)",
+            value: spec.spin_noise_rad_s,
+            expected: ">= 0",
+        })?;
+    let mut out = Vec::with_capacity(spec.n);
+    for i in 0..spec.n {
+        let v_n = lo * (hi / lo).powf(rng.random_range(0.0..=1.0));
+        let gamma = rng.random_range(g_lo..=g_hi).to_radians();
+        let phi = rng.random_range(0.0..std::f64::consts::TAU);
+        let n = Vector2::new(phi.cos(), phi.sin());
+        let t = Vector2::new(-n.y, n.x) * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+        let v_rel = -n * v_n + t * (v_n * gamma.tan());
+        let v_cm = Vector2::new(cm.sample(rng), cm.sample(rng));
+        let v1 = v_cm + v_rel * (m2 / (m1 + m2));
+        let v2 = v_cm - v_rel * (m1 / (m1 + m2));
+        let r1 = Vector2::zeros();
+        let r2 = r1 - n * (0.5 * (spec.d1_m + spec.d2_m));
+        let w = [spin.sample(rng), spin.sample(rng)];
+        let body = |s: &Sphere, r: Vector2<f64>, v: Vector2<f64>, w: f64| {
+            let mut b = Body::homogeneous(Vector3::new(r.x, r.y, 0.0), s);
+            b.inertia_k = spec.inertia_k;
+            b.moving(Vector3::new(v.x, v.y, 0.0), Vector3::new(0.0, 0.0, w))
+        };
+        let pre = State::pair(body(&s1, r1, v1, w[0]), body(&s2, r2, v2, w[1]));
+        // v_n of the contact point equals that of the centres: spins do not change it.
+        let e = e_of_v_n(v_n)?;
+        let post = walton::collide(&pre, &WaltonParams::new(e, spec.mu0, spec.beta0)?)?;
+        let walton::Target::Sphere(b2) = post.state.target else {
+            unreachable!("a pair stays a pair");
+        };
+        let vpost = [post.state.sphere.velocity_m_s.xy(), b2.velocity_m_s.xy()];
+        let scene = Scene {
+            r1_m: r1,
+            r2_m: r2,
+            v_pre_m_s: [v1, v2],
+            v_post_m_s: vpost,
+            g_m_s2: spec.g_m_s2,
+        };
+        let n_pre = spec.camera.frames_for(v1.norm().max(v2.norm()), rng);
+        let n_post = spec
+            .camera
+            .frames_for(vpost[0].norm().max(vpost[1].norm()), rng);
+        let (frames, split) = scene.film(&spec.camera, n_pre, n_post, rng);
+        let wpost = [post.state.sphere.spin_rad_s.z, b2.spin_rad_s.z];
+        let spins = [w[0], w[1], wpost[0], wpost[1]].map(|x| x + spin_noise.sample(rng));
+        out.push(Simulated {
+            id: format!("c{}", i + 1),
+            pre,
+            post: post.state,
+            e,
+            v_n_m_s: v_n,
+            beta: post.beta,
+            psi: post.psi,
+            kind: post.kind,
+            frames,
+            split,
+            spins_measured_rad_s: spins,
+        });
+    }
+    Ok(out)
+}
+
+/// One point of a camera study: how well a camera measures e at one normal speed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct StudyPoint {
+    pub camera: String,
+    pub fit: &'static str,
+    pub v_n_m_s: f64,
+    /// Collisions simulated and measured (the rest had too few frames for the fit).
+    pub simulated: usize,
+    pub measured: usize,
+    /// Mean and standard deviation of e_measured/e_true - 1 over the measured collisions.
+    pub bias: f64,
+    pub scatter: f64,
+}
+
+/// Monte Carlo of the measurement chain: for each camera and normal speed, simulate
+/// `per_point` collisions of `base` (the speed range collapsed to that speed), measure e from the
+/// tracks with free and fixed-gravity fits, and report the relative bias and scatter of e.
+pub fn camera_study(
+    base: &ExperimentSpec,
+    cameras: &[(String, Camera)],
+    v_n_m_s: &[f64],
+    per_point: usize,
+    e_of_v_n: &dyn Fn(f64) -> Result<f64>,
+    rng: &mut impl Rng,
+) -> Result<Vec<StudyPoint>> {
+    let kinds = [
+        ("free", FitKind::Free),
+        (
+            "fixed_gravity",
+            FitKind::FixedGravity {
+                g_m_s2: base.g_m_s2,
+            },
+        ),
+    ];
+    let mut out = Vec::new();
+    for (label, camera) in cameras {
+        for &v in v_n_m_s {
+            let spec = ExperimentSpec {
+                n: per_point,
+                v_n_range_m_s: (v, v),
+                camera: *camera,
+                ..*base
+            };
+            let sims = simulate(&spec, e_of_v_n, rng)?;
+            for (fit, kind) in kinds {
+                let rel: Vec<f64> = sims
+                    .iter()
+                    .filter_map(|s| {
+                        measure_e(&s.frames, s.split, spec.d1_m, spec.d2_m, kind)
+                            .ok()
+                            .map(|(e, _)| e / s.e - 1.0)
+                    })
+                    .filter(|x| x.is_finite())
+                    .collect();
+                let m = rel.len() as f64;
+                let bias = rel.iter().sum::<f64>() / m;
+                let scatter =
+                    (rel.iter().map(|x| (x - bias).powi(2)).sum::<f64>() / (m - 1.0)).sqrt();
+                out.push(StudyPoint {
+                    camera: label.clone(),
+                    fit,
+                    v_n_m_s: v,
+                    simulated: sims.len(),
+                    measured: rel.len(),
+                    bias: if rel.len() >= 2 { bias } else { f64::NAN },
+                    scatter: if rel.len() >= 2 { scatter } else { f64::NAN },
+                });
+            }
+        }
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

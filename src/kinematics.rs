@@ -25,8 +25,10 @@
 //!
 //! **Needs**: at least 3 frames per phase (free fits) or 2 (fixed gravity), distinct times.
 
+use crate::contact::{Material, Sphere};
 use crate::error::{Error, Result};
-use nalgebra::{DMatrix, DVector, Vector2};
+use crate::models::walton::{self, Body, Measured, State};
+use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 
 /// Standard gravity, m/s^2.
 pub const G_STANDARD_M_S2: f64 = 9.80665;
@@ -108,7 +110,16 @@ impl PolyFit {
     /// Variance of the slope at `t_s` per unit noise variance: J (X^T X)^-1 J^T, J = (0, 1, 2 tau).
     pub fn slope_variance_factor(&self, t_s: f64) -> f64 {
         let tau = t_s - self.t_ref_s;
-        let j = [0.0, 1.0, 2.0 * tau];
+        self.variance_factor([0.0, 1.0, 2.0 * tau])
+    }
+
+    /// Variance of the value at `t_s` per unit noise variance: J = (1, tau, tau^2).
+    pub fn value_variance_factor(&self, t_s: f64) -> f64 {
+        let tau = t_s - self.t_ref_s;
+        self.variance_factor([1.0, tau, tau * tau])
+    }
+
+    fn variance_factor(&self, j: [f64; 3]) -> f64 {
         let p = self.xtx_inv.nrows();
         let mut v = 0.0;
         for a in 0..p {
@@ -192,6 +203,10 @@ impl TimeRule {
 /// Velocities of both spheres before and after, at the collision time, with standard errors.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Kinematics {
+    /// Where the collision time is searched: last pre frame - dt .. first post frame + dt.
+    pub window_s: (f64, f64),
+    /// Centre distance at contact, (d1 + d2)/2, m.
+    pub contact_m: f64,
     pub t_c_s: f64,
     pub time_rule: TimeRule,
     /// Centres at t_c from the pre-collision fits.
@@ -199,10 +214,11 @@ pub struct Kinematics {
     pub r2_m: Vector2<f64>,
     /// Velocities: [sphere 1 pre, sphere 2 pre, sphere 1 post, sphere 2 post].
     pub v_m_s: [Vector2<f64>; 4],
-    /// Standard errors of each velocity component, same order.
-    pub v_err_m_s: [Vector2<f64>; 4],
-    /// Pooled position noise estimated from the fit residuals, m.
-    pub sigma_pos_m: f64,
+    /// Variance of each velocity component per unit position-noise variance, same order.
+    pub v_var_factor_per_m2: [Vector2<f64>; 4],
+    /// Sum of squared residuals over the eight fits, m^2, and its degrees of freedom.
+    pub rss_m2: f64,
+    pub dof: usize,
     pub n_pre: usize,
     pub n_post: usize,
     pub pre: PhaseFit,
@@ -272,22 +288,11 @@ pub fn analyse(
     } else {
         0.0
     };
-    let (lo, hi) = (pre.t_last_s - dt, post.t_first_s + dt);
+    let window = (pre.t_last_s - dt, post.t_first_s + dt);
     let contact = 0.5 * (d1_m + d2_m);
-    let gap = |t: f64| (pre.position(0, t) - pre.position(1, t)).norm() - contact;
-    let mismatch = |t: f64| {
-        (0..2)
-            .map(|s| (pre.position(s, t) - post.position(s, t)).norm_squared())
-            .sum::<f64>()
-    };
-    let (t_c, rule) = match first_crossing(&gap, lo, hi) {
-        Some(t) => (t, TimeRule::ContactDistance),
-        None => (argmin_scan(&mismatch, lo, hi), TimeRule::FitsMeet),
-    };
-    // Pooled residual variance over all eight fits.
+    let (t_c, rule) = collision_time(&pre, &post, contact, window, None);
     let all = pre.fits.iter().chain(post.fits.iter());
     let (rss, dof) = all.fold((0.0, 0usize), |(r, d), f| (r + f.rss, d + f.n - need));
-    let sigma2 = if dof > 0 { rss / dof as f64 } else { f64::NAN };
     let v = [
         pre.velocity(0, t_c),
         pre.velocity(1, t_c),
@@ -300,20 +305,105 @@ pub fn analyse(
         post.velocity_var_factor(0, t_c),
         post.velocity_var_factor(1, t_c),
     ];
-    let v_err = factor.map(|f| f.map(|x| (x * sigma2).sqrt()));
     Ok(Kinematics {
+        window_s: window,
+        contact_m: contact,
         t_c_s: t_c,
         time_rule: rule,
         r1_m: pre.position(0, t_c),
         r2_m: pre.position(1, t_c),
         v_m_s: v,
-        v_err_m_s: v_err,
-        sigma_pos_m: sigma2.sqrt(),
+        v_var_factor_per_m2: factor,
+        rss_m2: rss,
+        dof,
         n_pre: pre_frames.len(),
         n_post: post_frames.len(),
         pre,
         post,
     })
+}
+
+/// The collision time on `window` by `rule` (or the primary rule with its fallback when `None`).
+fn collision_time(
+    pre: &PhaseFit,
+    post: &PhaseFit,
+    contact_m: f64,
+    window: (f64, f64),
+    rule: Option<TimeRule>,
+) -> (f64, TimeRule) {
+    let (lo, hi) = window;
+    let gap = |t: f64| (pre.position(0, t) - pre.position(1, t)).norm() - contact_m;
+    let mismatch = |t: f64| {
+        (0..2)
+            .map(|s| (pre.position(s, t) - post.position(s, t)).norm_squared())
+            .sum::<f64>()
+    };
+    let crossing = match rule {
+        Some(TimeRule::FitsMeet) => None,
+        _ => first_crossing(&gap, lo, hi),
+    };
+    match crossing {
+        Some(t) => (t, TimeRule::ContactDistance),
+        None => (argmin_scan(&mismatch, lo, hi), TimeRule::FitsMeet),
+    }
+}
+
+/// (e, v_n) of the fits: the normal from the pre-collision centres at t_c, e = -(v1' - v2').n /
+/// (v1 - v2).n, v_n = -(v1 - v2).n. The same numbers [`walton::measure`] gives (spins do not
+/// enter the normal components); used here to propagate the fits' covariance.
+fn normal_restitution(pre: &PhaseFit, post: &PhaseFit, t_c: f64) -> (f64, f64) {
+    let n = (pre.position(0, t_c) - pre.position(1, t_c)).normalize();
+    let b = (pre.velocity(0, t_c) - pre.velocity(1, t_c)).dot(&n);
+    let a = (post.velocity(0, t_c) - post.velocity(1, t_c)).dot(&n);
+    (-a / b, -b)
+}
+
+/// Standard errors of (e, v_n) by linear propagation of every fit parameter's covariance
+/// (sigma^2 (X^T X)^-1 per fit; fits independent) through the whole chain, collision time and
+/// normal included, with central differences of step 1e-4 standard deviations.
+fn propagate(k: &Kinematics, sigma: f64) -> (f64, f64) {
+    let eval = |pre: &PhaseFit, post: &PhaseFit| {
+        let (t_c, _) = collision_time(pre, post, k.contact_m, k.window_s, Some(k.time_rule));
+        normal_restitution(pre, post, t_c)
+    };
+    let (mut var_e, mut var_vn) = (0.0, 0.0);
+    for phase in 0..2 {
+        for f in 0..4 {
+            let fit = if phase == 0 {
+                &k.pre.fits[f]
+            } else {
+                &k.post.fits[f]
+            };
+            let p = fit.xtx_inv.nrows();
+            let mut grad = vec![(0.0, 0.0); p];
+            for (j, g) in grad.iter_mut().enumerate() {
+                let h = 1e-4 * sigma * fit.xtx_inv[(j, j)].sqrt();
+                let shifted = |delta: f64| {
+                    let (mut pre, mut post) = (k.pre.clone(), k.post.clone());
+                    let target = if phase == 0 {
+                        &mut pre.fits[f]
+                    } else {
+                        &mut post.fits[f]
+                    };
+                    target.coef[j] += delta;
+                    eval(&pre, &post)
+                };
+                let (plus, minus) = (shifted(h), shifted(-h));
+                *g = (
+                    (plus.0 - minus.0) / (2.0 * h),
+                    (plus.1 - minus.1) / (2.0 * h),
+                );
+            }
+            for a in 0..p {
+                for b in 0..p {
+                    let c = sigma * sigma * fit.xtx_inv[(a, b)];
+                    var_e += grad[a].0 * c * grad[b].0;
+                    var_vn += grad[a].1 * c * grad[b].1;
+                }
+            }
+        }
+    }
+    (var_e.sqrt(), var_vn.sqrt())
 }
 
 /// First crossing of f from > 0 to <= 0 on [lo, hi], by a scan and bisection to rounding.
@@ -376,6 +466,118 @@ pub fn eq8_velocity_error_m_s(
     n_frames: usize,
 ) -> f64 {
     s_subpixels * subpixel_m / (dt_s * (n_frames as f64).sqrt())
+}
+
+/// e and v_n of one collision from its tracks, without error propagation (for Monte Carlo
+/// studies, where the scatter over repetitions is the error).
+pub fn measure_e(
+    frames: &[Frame],
+    split: usize,
+    d1_m: f64,
+    d2_m: f64,
+    kind: FitKind,
+) -> Result<(f64, f64)> {
+    let k = analyse(frames, split, d1_m, d2_m, kind)?;
+    Ok(normal_restitution(&k.pre, &k.post, k.t_c_s))
+}
+
+/// The camera numbers Eq. (8) needs besides the frame interval and count.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Eq8Inputs {
+    /// Accuracy of a centre, subpixels (the paper: s = 1 +- 0.5 measured, 2 quoted).
+    pub s_subpixels: f64,
+    /// Size of a subpixel in the object plane, m.
+    pub subpixel_m: f64,
+}
+
+/// One collision measured from its tracks: the velocities, Walton's e, beta and psi from them
+/// ([`walton::measure`]), and two error estimates of e.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measurement {
+    pub kinematics: Kinematics,
+    pub pre: State,
+    pub post: State,
+    pub measured: Measured,
+    /// The position noise the errors below assume, m.
+    pub sigma_pos_m: f64,
+    /// Standard errors of each velocity component: [1 pre, 2 pre, 1 post, 2 post], m/s.
+    pub v_err_m_s: [Vector2<f64>; 4],
+    /// Standard error of e from the fits' covariance, propagated through the whole chain: the
+    /// velocities, and the normal's direction through the centres and the collision time (a
+    /// position error along n shifts t_c by delta/v_n, while r1 - r2 turns at v_t/|r1 - r2|:
+    /// for grazing impacts this dominates).
+    pub e_err: f64,
+    /// Standard error of v_n from the fits' covariance, m/s.
+    pub v_n_err_m_s: f64,
+    /// Eq. (8) for a relative velocity component, with N the mean frames per phase, m/s.
+    pub eq8_dv_m_s: f64,
+    /// The paper's error of e from Eq. (8): Delta e = 2 e Delta v / v_n.
+    pub e_err_eq8: f64,
+}
+
+/// Runs the whole chain for one collision: fits, collision time, velocities, then Walton's
+/// measurement. `spins_rad_s` are the z spins [1 pre, 2 pre, 1 post, 2 post] from markers.
+///
+/// `sigma_pos_m` is the position noise behind the error estimates. `None` estimates it from this
+/// collision's residuals, or, without residual degrees of freedom (3 frames a phase with free
+/// fits), takes the camera's stated accuracy s x subpixel. A caller with many collisions from one
+/// camera does better to pool the residuals over all of them ([`Kinematics::rss_m2`], `dof`).
+#[allow(clippy::too_many_arguments)]
+pub fn measure_collision(
+    frames: &[Frame],
+    split: usize,
+    d1_m: f64,
+    d2_m: f64,
+    material: &Material,
+    inertia_k: f64,
+    spins_rad_s: [f64; 4],
+    kind: FitKind,
+    eq8: &Eq8Inputs,
+    sigma_pos_m: Option<f64>,
+) -> Result<Measurement> {
+    let k = analyse(frames, split, d1_m, d2_m, kind)?;
+    let sigma = match sigma_pos_m {
+        Some(s) => s,
+        None if k.dof > 0 => (k.rss_m2 / k.dof as f64).sqrt(),
+        None => eq8.s_subpixels * eq8.subpixel_m,
+    };
+    let v_err = k
+        .v_var_factor_per_m2
+        .map(|f| f.map(|x| (x * sigma * sigma).sqrt()));
+    let body = |d: f64, r: Vector2<f64>, v: Vector2<f64>, w: f64| -> Result<Body> {
+        let mut b = Body::homogeneous(Vector3::new(r.x, r.y, 0.0), &Sphere::new(d, *material)?);
+        b.inertia_k = inertia_k;
+        Ok(b.moving(Vector3::new(v.x, v.y, 0.0), Vector3::new(0.0, 0.0, w)))
+    };
+    let pre = State::pair(
+        body(d1_m, k.r1_m, k.v_m_s[0], spins_rad_s[0])?,
+        body(d2_m, k.r2_m, k.v_m_s[1], spins_rad_s[1])?,
+    );
+    let post = State::pair(
+        body(d1_m, k.r1_m, k.v_m_s[2], spins_rad_s[2])?,
+        body(d2_m, k.r2_m, k.v_m_s[3], spins_rad_s[3])?,
+    );
+    let measured = walton::measure(&pre, &post)?;
+    let (e_err, v_n_err) = propagate(&k, sigma);
+    let e = measured.e;
+    let dt = frames
+        .windows(2)
+        .map(|w| w[1].t_s - w[0].t_s)
+        .fold(f64::INFINITY, f64::min);
+    let n_mean = (k.n_pre + k.n_post) / 2;
+    let eq8_dv = eq8_velocity_error_m_s(eq8.s_subpixels, eq8.subpixel_m, dt, n_mean);
+    Ok(Measurement {
+        sigma_pos_m: sigma,
+        v_err_m_s: v_err,
+        e_err,
+        v_n_err_m_s: v_n_err,
+        eq8_dv_m_s: eq8_dv,
+        e_err_eq8: 2.0 * e * eq8_dv / measured.v_n_m_s,
+        kinematics: k,
+        pre,
+        post,
+        measured,
+    })
 }
 
 #[cfg(test)]

@@ -20,11 +20,24 @@ enum Command {
     Predict(cli::predict::Args),
     /// Speed against accuracy: work-precision chart and stability map of every method
     Bench(cli::bench::Args),
+    /// Fit eta and sigma_y (and more) to measured e(v_n), with uncertainties and a model comparison
+    Fit(cli::fit::Args),
+    /// Velocities, e, beta and psi from tracked sphere centres (Sec. III)
+    Kinematics(cli::kinematics::Args),
+    /// A virtual experiment: simulated tracks of collisions seen by a high-speed camera
+    Simulate(cli::simulate::Args),
     /// Walton's collision operator: fit e, beta_0 and mu_0 to oblique collisions (Fig. 6)
     Walton(cli::walton::Args),
 }
 
 fn main() -> ExitCode {
+    // Rust ignores SIGPIPE, so `restitution ... | head` would panic on the closed pipe; the
+    // default action ends the process quietly, as Unix tools do.
+    #[cfg(unix)]
+    // SAFETY: restoring the default disposition of SIGPIPE before any thread or I/O exists.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
@@ -47,7 +60,10 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Predict(args) => cli::predict::run(args),
         Command::Bench(args) => cli::bench::run(args),
+        Command::Fit(args) => cli::fit::run(args),
         Command::Walton(args) => cli::walton::run(args),
+        Command::Kinematics(args) => cli::kinematics::run(args),
+        Command::Simulate(args) => cli::simulate::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

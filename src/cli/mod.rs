@@ -4,7 +4,10 @@
 use restitution::contact::{Material, PRESETS};
 
 pub mod bench;
+pub mod fit;
+pub mod kinematics;
 pub mod predict;
+pub mod simulate;
 pub mod walton;
 
 /// What a subcommand returns: `Err` is one line for stderr (the binary prefixes it and exits 1).

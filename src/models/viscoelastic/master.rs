@@ -9,8 +9,10 @@
 //! **How**: `PIECES` equal intervals in s, each a Chebyshev interpolant of degree `DEGREE` through
 //! the ODE at its tightest setting ([`super::OdeSettings::REFERENCE`]) at Chebyshev nodes, made by
 //! `examples/gen_master_curve.rs` (committed) and checked by it at points between the nodes. The
-//! generator's measured maximum errors are [`MAX_ABS_ERROR_E`] and [`MAX_REL_ERROR_ONE_MINUS_E`];
-//! tests/viscoelastic.rs checks the table against the independent mpmath reference values.
+//! generator's measured maximum errors are [`MAX_ABS_ERROR_E`] and [`MAX_REL_ERROR_ONE_MINUS_E`]
+//! (2.4e-15 and 4.9e-15 for the committed 40 pieces of degree 16, over kappa in (0, 100] and both
+//! rules); tests/viscoelastic.rs checks the table against the independent mpmath reference values
+//! (bar: 1e-12 in e, 1e-11 relative in 1 - e).
 //!
 //! **Outside** [0, `KAPPA_MAX`] there is no table: [`restitution_master`] returns `None` and
 //! [`super::restitution`] falls back to the ODE.

@@ -1,0 +1,398 @@
+//! `restitution kinematics`: from tracked sphere centres to velocities, e, beta and psi.
+//!
+//! ```text
+//! restitution kinematics TRACKS.csv
+//!     (--material NAME | --youngs-pa Y --poisson NU --density-kg-m3 RHO)
+//!     [--fixed-gravity [--g-m-s2 G]] [--inertia-k K]
+//!     [--s-subpixels S] [--subpixel-m P | --fov-m W --pixels-x N --subpixel-expansion X]
+//!     [--format table|csv|json] [--out DIR]
+//! ```
+//! TRACKS.csv: `collision,t_s,x1_m,y1_m,x2_m,y2_m,d1_mm,d2_mm`, optional `phase` (pre/post) and
+//! `w1z_rad_s,w2z_rad_s,w1z_post_rad_s,w2z_post_rad_s` (spins from markers). y is up.
+//!
+//! Per collision: quadratic fits per coordinate and phase (or straight lines plus gravity with
+//! `--fixed-gravity`), the collision time (centre distance reaching (d1 + d2)/2 on the
+//! pre-collision fits; fallback, flagged `fits_meet`: where pre and post fits come closest), the
+//! velocities there, v_n, e, beta, psi, the momentum check, and e's error both from the fits'
+//! covariance (`e_err`) and from Eq. (8) (`e_err_eq8`). `--out DIR` writes `kinematics.csv`,
+//! `fit_input.csv` (the `restitution fit` schema) and `walton_input.csv` (the `walton fit`
+//! schema), all or none, so that the three commands chain.
+
+use super::{CliResult, Format, MaterialArgs};
+use restitution::data::tracks::read_tracks;
+use restitution::data::{fmt_num, write_all_atomic};
+use restitution::experiment::Camera;
+use restitution::fit::walton::{CollisionRecord, write_collisions};
+use restitution::kinematics::{
+    Eq8Inputs, FitKind, G_STANDARD_M_S2, Measurement, analyse, measure_collision, split_at_contact,
+};
+use restitution::models::walton::K_HOMOGENEOUS;
+use std::path::PathBuf;
+
+/// Velocities, e, beta and psi from tracked sphere centres (Sec. III)
+#[derive(clap::Args, Debug)]
+pub struct Args {
+    /// Tracks CSV (collision, t_s, x1_m, y1_m, x2_m, y2_m, d1_mm, d2_mm [, phase, spins])
+    #[arg(value_name = "TRACKS.csv")]
+    path: PathBuf,
+    #[command(flatten)]
+    material: MaterialArgs,
+    /// Fit straight lines plus the known gravity (y up) instead of free quadratics
+    #[arg(long = "fixed-gravity")]
+    fixed_gravity: bool,
+    /// Gravitational acceleration for --fixed-gravity, m/s^2
+    #[arg(long = "g-m-s2", value_name = "G", default_value_t = G_STANDARD_M_S2)]
+    g_m_s2: f64,
+    /// Inertia factor K = 4I/(m d^2) (2/5 for homogeneous spheres)
+    #[arg(long = "inertia-k", value_name = "K", default_value_t = K_HOMOGENEOUS)]
+    inertia_k: f64,
+    /// Eq. (8): accuracy of a centre in subpixels
+    #[arg(long = "s-subpixels", value_name = "S", default_value_t = Camera::PAPER.s_subpixels)]
+    s_subpixels: f64,
+    /// Eq. (8): subpixel size in the object plane, m (default: from the field of view)
+    #[arg(long = "subpixel-m", value_name = "P")]
+    subpixel_m: Option<f64>,
+    /// Field of view width, m
+    #[arg(long = "fov-m", value_name = "W", default_value_t = Camera::PAPER.fov_x_m)]
+    fov_m: f64,
+    /// Camera pixels across the field of view
+    #[arg(long = "pixels-x", value_name = "N", default_value_t = Camera::PAPER.pixels_x)]
+    pixels_x: u32,
+    /// Subpixel expansion factor
+    #[arg(long = "subpixel-expansion", value_name = "X", default_value_t = Camera::PAPER.subpixel_expansion)]
+    subpixel_expansion: f64,
+    #[arg(long, value_enum, default_value = "table")]
+    format: Format,
+    /// Stop at the first collision that cannot be measured instead of skipping it
+    #[arg(long)]
+    strict: bool,
+    /// Write kinematics.csv, fit_input.csv and walton_input.csv here
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+}
+
+const COLUMNS: [&str; 27] = [
+    "collision",
+    "t_c_s",
+    "time_rule",
+    "n_pre",
+    "n_post",
+    "v1x_m_s",
+    "v1y_m_s",
+    "v2x_m_s",
+    "v2y_m_s",
+    "v1x_post_m_s",
+    "v1y_post_m_s",
+    "v2x_post_m_s",
+    "v2y_post_m_s",
+    "v_err_m_s",
+    "sigma_pos_m",
+    "v_n_m_s",
+    "v_n_err_m_s",
+    "e",
+    "e_err",
+    "e_err_eq8",
+    "eq8_dv_m_s",
+    "beta",
+    "psi",
+    "momentum_dvx_m_s",
+    "momentum_dvy_m_s",
+    "d1_mm",
+    "d2_mm",
+];
+
+struct Row {
+    id: String,
+    d1_mm: f64,
+    d2_mm: f64,
+    m: Measurement,
+}
+
+impl Row {
+    fn cells(&self) -> Vec<String> {
+        let k = &self.m.kinematics;
+        let me = &self.m.measured;
+        let v_err = self
+            .m
+            .v_err_m_s
+            .iter()
+            .map(|v| v.norm_squared())
+            .sum::<f64>()
+            / 8.0;
+        let dv = me.com_velocity_change_m_s.unwrap_or_default();
+        let mut c = vec![
+            self.id.clone(),
+            fmt_num(k.t_c_s),
+            k.time_rule.name().into(),
+            k.n_pre.to_string(),
+            k.n_post.to_string(),
+        ];
+        for v in &k.v_m_s {
+            c.push(fmt_num(v.x));
+            c.push(fmt_num(v.y));
+        }
+        for x in [
+            v_err.sqrt(),
+            self.m.sigma_pos_m,
+            me.v_n_m_s,
+            self.m.v_n_err_m_s,
+            me.e,
+            self.m.e_err,
+            self.m.e_err_eq8,
+            self.m.eq8_dv_m_s,
+        ] {
+            c.push(fmt_num(x));
+        }
+        c.push(me.beta.map(fmt_num).unwrap_or_default());
+        c.push(fmt_num(me.psi));
+        c.push(fmt_num(dv.x));
+        c.push(fmt_num(dv.y));
+        c.push(fmt_num(self.d1_mm));
+        c.push(fmt_num(self.d2_mm));
+        c
+    }
+}
+
+pub fn run(args: Args) -> CliResult {
+    let material = args.material.resolve()?;
+    for (flag, v) in [
+        ("--g-m-s2", args.g_m_s2),
+        ("--s-subpixels", args.s_subpixels),
+        ("--fov-m", args.fov_m),
+        ("--subpixel-expansion", args.subpixel_expansion),
+        ("--inertia-k", args.inertia_k),
+    ] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(format!("{flag} {v}: expected a number > 0"));
+        }
+    }
+    if args.pixels_x == 0 {
+        return Err("--pixels-x 0: expected a pixel count > 0".into());
+    }
+    let subpixel_m = match args.subpixel_m {
+        Some(p) if p.is_finite() && p > 0.0 => p,
+        Some(p) => return Err(format!("--subpixel-m {p}: expected a size > 0 (m)")),
+        None => args.fov_m / args.pixels_x as f64 / args.subpixel_expansion,
+    };
+    let eq8 = Eq8Inputs {
+        s_subpixels: args.s_subpixels,
+        subpixel_m,
+    };
+    let kind = if args.fixed_gravity {
+        FitKind::FixedGravity {
+            g_m_s2: args.g_m_s2,
+        }
+    } else {
+        FitKind::Free
+    };
+    let tracks = read_tracks(&args.path).map_err(|e| e.to_string())?;
+    let shown = args.path.display().to_string();
+    // Two passes: the position noise is one camera's, so the residuals of all collisions are
+    // pooled into one estimate (a 10-frame fit alone estimates it poorly), then every error uses it.
+    let place = |t: &restitution::data::tracks::CollisionTrack| {
+        format!("{shown}:{}: collision '{}'", t.first_line, t.id)
+    };
+    let mut splits = Vec::new();
+    let (mut rss, mut dof) = (0.0, 0usize);
+    // A collision that cannot be measured (too few frames, receding spheres) is skipped with a
+    // warning naming it, so one bad track does not lose a campaign; --strict makes it an error.
+    let mut skipped = Vec::new();
+    for t in &tracks {
+        let split = t
+            .split
+            .map(Ok)
+            .unwrap_or_else(|| split_at_contact(&t.frames, kind));
+        match split
+            .and_then(|split| analyse(&t.frames, split, t.d1_m, t.d2_m, kind).map(|k| (split, k)))
+        {
+            Ok((split, k)) => {
+                rss += k.rss_m2;
+                dof += k.dof;
+                splits.push(Some(split));
+            }
+            Err(e) => {
+                skipped.push(format!("{}: {e}", place(t)));
+                splits.push(None);
+            }
+        }
+    }
+    let sigma = if dof > 0 {
+        (rss / dof as f64).sqrt()
+    } else {
+        eq8.s_subpixels * eq8.subpixel_m
+    };
+    let mut rows = Vec::new();
+    let mut records = Vec::new();
+    for (t, split) in tracks.iter().zip(&splits) {
+        let Some(split) = *split else { continue };
+        let m = match measure_collision(
+            &t.frames,
+            split,
+            t.d1_m,
+            t.d2_m,
+            &material,
+            args.inertia_k,
+            t.spins_rad_s.unwrap_or([0.0; 4]),
+            kind,
+            &eq8,
+            Some(sigma),
+        ) {
+            Ok(m) => m,
+            Err(e) => {
+                skipped.push(format!("{}: {e}", place(t)));
+                continue;
+            }
+        };
+        records.push(CollisionRecord {
+            line: t.first_line,
+            id: Some(t.id.clone()),
+            pre: m.pre,
+            post: m.post,
+        });
+        rows.push(Row {
+            id: t.id.clone(),
+            d1_mm: t.d1_m * 1e3,
+            d2_mm: t.d2_m * 1e3,
+            m,
+        });
+    }
+    if !skipped.is_empty() {
+        if args.strict || rows.is_empty() {
+            return Err(skipped.swap_remove(0));
+        }
+        for s in &skipped {
+            eprintln!("restitution: warning: skipped {s}");
+        }
+    }
+    let fallbacks: Vec<&str> = rows
+        .iter()
+        .filter(|r| r.m.kinematics.time_rule != restitution::kinematics::TimeRule::ContactDistance)
+        .map(|r| r.id.as_str())
+        .collect();
+    if !fallbacks.is_empty() {
+        eprintln!(
+            "restitution: warning: {} collision(s) never reach contact distance on the pre-collision fits (noise); their time is where pre and post fits meet: {}",
+            fallbacks.len(),
+            fallbacks.join(", ")
+        );
+    }
+    let table_csv = {
+        let mut s = COLUMNS.join(",") + "\n";
+        for r in &rows {
+            s += &(r.cells().join(",") + "\n");
+        }
+        s
+    };
+    if let Some(dir) = &args.out {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+        let mut fit_csv = String::from("d_mm,d2_mm,v_n_m_s,e,e_err\n");
+        for r in &rows {
+            fit_csv += &format!(
+                "{},{},{},{},{}\n",
+                fmt_num(r.d1_mm),
+                fmt_num(r.d2_mm),
+                fmt_num(r.m.measured.v_n_m_s),
+                fmt_num(r.m.measured.e),
+                fmt_num(r.m.e_err)
+            );
+        }
+        let header = format!(
+            "# made by restitution kinematics from {shown} ({})\n",
+            if args.fixed_gravity {
+                "fixed-gravity fits"
+            } else {
+                "free quadratic fits"
+            }
+        );
+        write_all_atomic(&[
+            (
+                dir.join("kinematics.csv"),
+                (header.clone() + &table_csv).into_bytes(),
+            ),
+            (
+                dir.join("fit_input.csv"),
+                (header.clone() + &fit_csv).into_bytes(),
+            ),
+            (
+                dir.join("walton_input.csv"),
+                (header + &write_collisions(&records)).into_bytes(),
+            ),
+        ])
+        .map_err(|e| format!("{}: cannot write: {e}", dir.display()))?;
+    }
+    match args.format {
+        Format::Csv => print!("{table_csv}"),
+        Format::Json => {
+            let list: Vec<serde_json::Value> = rows
+                .iter()
+                .map(|r| {
+                    let map: serde_json::Map<String, serde_json::Value> = COLUMNS
+                        .iter()
+                        .zip(r.cells())
+                        .map(|(c, v)| {
+                            let val = match v.parse::<f64>() {
+                                Ok(x) if *c != "collision" && *c != "time_rule" => {
+                                    serde_json::json!(x)
+                                }
+                                _ if v.is_empty() => serde_json::Value::Null,
+                                _ => serde_json::json!(v),
+                            };
+                            (c.to_string(), val)
+                        })
+                        .collect();
+                    serde_json::Value::Object(map)
+                })
+                .collect();
+            println!(
+                "{}",
+                serde_json::to_string_pretty(&list).expect("serialisable")
+            );
+        }
+        Format::Table => {
+            println!(
+                "{:>10} {:>7} {:>9} {:>8} {:>8} {:>8} {:>8} {:>7} {:>7} {:>5}/{:<5} time",
+                "collision",
+                "v_n",
+                "e",
+                "e_err",
+                "e_eq8",
+                "beta",
+                "psi",
+                "dv_x",
+                "dv_y",
+                "n_pre",
+                "post"
+            );
+            for r in &rows {
+                let me = &r.m.measured;
+                let dv = me.com_velocity_change_m_s.unwrap_or_default();
+                println!(
+                    "{:>10} {:>7.3} {:>9.4} {:>8.4} {:>8.4} {:>8} {:>8.3} {:>7.3} {:>7.3} {:>5}/{:<5} {}",
+                    r.id,
+                    me.v_n_m_s,
+                    me.e,
+                    r.m.e_err,
+                    r.m.e_err_eq8,
+                    me.beta
+                        .map(|b| format!("{b:.3}"))
+                        .unwrap_or_else(|| "-".into()),
+                    me.psi,
+                    dv.x,
+                    dv.y,
+                    r.m.kinematics.n_pre,
+                    r.m.kinematics.n_post,
+                    r.m.kinematics.time_rule.name()
+                );
+            }
+            println!(
+                "(speeds m/s; e_err from the fits' covariance with the position noise pooled over all collisions: {} m = {:.2} subpixels; e_eq8 from Eq. 8 with s = {} subpixels of {} m; dv: momentum check)",
+                fmt_num(sigma),
+                sigma / subpixel_m,
+                fmt_num(args.s_subpixels),
+                fmt_num(subpixel_m)
+            );
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,71 @@
+//! Model comparison by Akaike's information criterion (Burnham & Anderson, "Model Selection and
+//! Multimodel Inference", 2nd ed., 2002, §2.2 and §2.9).
+//!
+//! Delta AIC_i = AIC_i - min AIC; Akaike weight w_i = exp(-Delta_i/2) / sum_j exp(-Delta_j/2), the
+//! relative support of model i within the set. The preferred model follows Burnham & Anderson's
+//! rule of thumb that models within Delta AIC <= 2 have substantial support: among the converged
+//! fits within 2 of the best, the one with the fewest parameters (then the lower AIC) is named,
+//! so that the data are not described with more than they support.
+
+use super::engine::FitResult;
+use super::models::ModelKind;
+
+/// How the preferred model is chosen, for reports.
+pub const PREFERENCE_RULE: &str = "lowest AIC; among converged models within delta AIC <= 2 of it, the one with the fewest parameters";
+
+/// One model's line in the comparison table.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ComparisonRow {
+    pub model: ModelKind,
+    pub k: usize,
+    pub chi2: f64,
+    pub reduced_chi2: f64,
+    pub aic: f64,
+    pub bic: f64,
+    pub delta_aic: f64,
+    pub akaike_weight: f64,
+    pub converged: bool,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Comparison {
+    pub rows: Vec<ComparisonRow>,
+    /// `None` when no fit converged.
+    pub preferred: Option<ModelKind>,
+}
+
+/// Compares fitted models of the same data (their AICs are only comparable then).
+pub fn compare(fits: &[FitResult]) -> Comparison {
+    let min_aic = fits.iter().map(|f| f.aic).fold(f64::INFINITY, f64::min);
+    let raw: Vec<f64> = fits
+        .iter()
+        .map(|f| (-(f.aic - min_aic) / 2.0).exp())
+        .collect();
+    let total: f64 = raw.iter().sum();
+    let rows: Vec<ComparisonRow> = fits
+        .iter()
+        .zip(&raw)
+        .map(|(f, w)| ComparisonRow {
+            model: f.model,
+            k: f.k(),
+            chi2: f.chi2,
+            reduced_chi2: f.reduced_chi2,
+            aic: f.aic,
+            bic: f.bic,
+            delta_aic: f.aic - min_aic,
+            akaike_weight: w / total,
+            converged: f.converged,
+        })
+        .collect();
+    let best_conv = rows
+        .iter()
+        .filter(|r| r.converged)
+        .map(|r| r.aic)
+        .fold(f64::INFINITY, f64::min);
+    let preferred = rows
+        .iter()
+        .filter(|r| r.converged && r.aic <= best_conv + 2.0)
+        .min_by(|a, b| a.k.cmp(&b.k).then(a.aic.total_cmp(&b.aic)))
+        .map(|r| r.model);
+    Comparison { rows, preferred }
+}

@@ -1,0 +1,209 @@
+//! Measured coefficients of restitution, ready for fitting: one [`Observation`] per collision,
+//! with the Hertz contact of its pair derived once (PHYSICS.md §1).
+//!
+//! Pure data: no file reading here (that is [`super::input`]), so that the kinematics pipeline and
+//! the benchmarks can build a [`FitData`] from numbers they already hold.
+
+use crate::contact::{Contact, Material, Pair, Sphere};
+use crate::error::{Error, Result};
+
+/// One measured collision.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Observation {
+    /// Diameter of the (first) sphere, mm.
+    pub d_mm: f64,
+    /// Diameter of the second sphere, mm: `None` for identical spheres, `Some(f64::INFINITY)` for
+    /// a flat wall (of the same material).
+    pub d2_mm: Option<f64>,
+    /// Normal impact speed, m/s.
+    pub v_n_m_s: f64,
+    /// Measured coefficient of restitution.
+    pub e: f64,
+    /// One-sigma error of `e`; `None` when the data carry no error information.
+    pub e_err: Option<f64>,
+}
+
+/// A group of observations of one pair geometry (one colour and marker in the figures).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Group {
+    pub d_mm: f64,
+    pub d2_mm: Option<f64>,
+    /// Row indices into [`FitData::obs`].
+    pub indices: Vec<usize>,
+}
+
+impl Group {
+    /// "6.35 mm", "12.7 mm on wall", "6.35 mm on 25.4 mm".
+    pub fn label(&self) -> String {
+        match self.d2_mm {
+            None => format!("{} mm", self.d_mm),
+            Some(d2) if d2.is_infinite() => format!("{} mm on wall", self.d_mm),
+            Some(d2) => format!("{} mm on {} mm", self.d_mm, d2),
+        }
+    }
+}
+
+/// The data of a fit: the material, the observations, and each observation's contact.
+#[derive(Debug, Clone)]
+pub struct FitData {
+    pub material: Material,
+    pub obs: Vec<Observation>,
+    /// Contact of each observation's pair (same order as `obs`).
+    pub contacts: Vec<Contact>,
+    /// True when every observation has an error; false when none has (unweighted fit).
+    pub weighted: bool,
+}
+
+/// `x > 0` fails, NaN included.
+fn not_positive(x: f64) -> bool {
+    x.is_nan() || x <= 0.0
+}
+
+fn bad(name: &'static str, value: f64, expected: &'static str) -> Error {
+    Error::InvalidParameter {
+        name,
+        value,
+        expected,
+    }
+}
+
+/// The contact of a pair of the given material (PHYSICS.md §1): identical spheres, unequal
+/// spheres, or a sphere on a wall when `d2_mm` is infinite.
+pub fn pair_contact(material: Material, d_mm: f64, d2_mm: Option<f64>) -> Result<Contact> {
+    let s1 = Sphere::new(d_mm * 1e-3, material)?;
+    let pair = match d2_mm {
+        None => Pair::identical(s1),
+        Some(d2) if d2 == f64::INFINITY => Pair::on_wall(s1, material),
+        Some(d2) => Pair::unequal(s1, Sphere::new(d2 * 1e-3, material)?),
+    };
+    Ok(pair.contact())
+}
+
+impl FitData {
+    /// Validates the observations (d > 0, v_n > 0, e >= 0 finite, e_err > 0 finite, either every
+    /// row has an error or none has) and derives each pair's contact.
+    pub fn new(material: Material, obs: Vec<Observation>) -> Result<FitData> {
+        if obs.is_empty() {
+            return Err(bad("number of observations", 0.0, "at least one"));
+        }
+        let with_err = obs.iter().filter(|o| o.e_err.is_some()).count();
+        if with_err != 0 && with_err != obs.len() {
+            return Err(bad(
+                "number of observations with an error",
+                with_err as f64,
+                "all or none",
+            ));
+        }
+        let mut contacts = Vec::with_capacity(obs.len());
+        for o in &obs {
+            if !(o.v_n_m_s.is_finite() && o.v_n_m_s > 0.0) {
+                return Err(bad("v_n (m/s)", o.v_n_m_s, "a finite number > 0"));
+            }
+            if !(o.e.is_finite() && o.e >= 0.0) {
+                return Err(bad("e", o.e, "a finite number >= 0"));
+            }
+            if let Some(s) = o.e_err
+                && !(s.is_finite() && s > 0.0)
+            {
+                return Err(bad("e_err", s, "a finite number > 0"));
+            }
+            if let Some(d2) = o.d2_mm
+                && not_positive(d2)
+            {
+                return Err(bad("d2 (mm)", d2, "a number > 0, or infinity for a wall"));
+            }
+            contacts.push(pair_contact(material, o.d_mm, o.d2_mm)?);
+        }
+        Ok(FitData {
+            material,
+            obs,
+            contacts,
+            weighted: with_err != 0,
+        })
+    }
+
+    pub fn len(&self) -> usize {
+        self.obs.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.obs.is_empty()
+    }
+
+    /// The sigma of row `i` in chi2: its error, or 1 for an unweighted fit.
+    pub fn sigma(&self, i: usize) -> f64 {
+        self.obs[i].e_err.unwrap_or(1.0)
+    }
+
+    /// The distinct pair geometries, in order of first appearance sorted by diameter.
+    pub fn groups(&self) -> Vec<Group> {
+        let mut groups: Vec<Group> = Vec::new();
+        for (i, o) in self.obs.iter().enumerate() {
+            match groups
+                .iter_mut()
+                .find(|g| g.d_mm == o.d_mm && g.d2_mm == o.d2_mm)
+            {
+                Some(g) => g.indices.push(i),
+                None => groups.push(Group {
+                    d_mm: o.d_mm,
+                    d2_mm: o.d2_mm,
+                    indices: vec![i],
+                }),
+            }
+        }
+        groups.sort_by(|a, b| {
+            a.d_mm
+                .total_cmp(&b.d_mm)
+                .then(a.d2_mm.unwrap_or(0.0).total_cmp(&b.d2_mm.unwrap_or(0.0)))
+        });
+        groups
+    }
+
+    /// Distinct first-sphere diameters, ascending, mm.
+    pub fn diameters_mm(&self) -> Vec<f64> {
+        let mut d: Vec<f64> = self.obs.iter().map(|o| o.d_mm).collect();
+        d.sort_by(f64::total_cmp);
+        d.dedup();
+        d
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn obs(d_mm: f64, e_err: Option<f64>) -> Observation {
+        Observation {
+            d_mm,
+            d2_mm: None,
+            v_n_m_s: 1.0,
+            e: 0.9,
+            e_err,
+        }
+    }
+
+    #[test]
+    fn validates_and_groups() {
+        let m = Material::preset("nylon").unwrap();
+        assert!(FitData::new(m, vec![]).is_err());
+        assert!(FitData::new(m, vec![obs(1.0, Some(0.1)), obs(2.0, None)]).is_err());
+        assert!(FitData::new(m, vec![obs(1.0, Some(0.0))]).is_err());
+        assert!(FitData::new(m, vec![obs(-1.0, None)]).is_err());
+        let mut wall = obs(2.0, None);
+        wall.d2_mm = Some(f64::INFINITY);
+        let d = FitData::new(
+            m,
+            vec![obs(2.0, None), obs(1.0, None), wall, obs(2.0, None)],
+        )
+        .unwrap();
+        assert!(!d.weighted);
+        let g = d.groups();
+        assert_eq!(g.len(), 3);
+        assert_eq!(g[0].label(), "1 mm");
+        assert_eq!(g[1].indices, vec![0, 3]);
+        assert_eq!(g[2].label(), "2 mm on wall");
+        assert_eq!(d.diameters_mm(), vec![1.0, 2.0]);
+        // A wall's contact has R~ = R_1 (PHYSICS.md §1).
+        assert_eq!(d.contacts[2].r_eff_m, 1e-3);
+    }
+}

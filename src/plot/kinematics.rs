@@ -1,0 +1,151 @@
+//! The camera study: relative scatter and bias of measured e against the normal impact speed,
+//! one line per camera, solid for free quadratic fits, dashed for fixed-gravity fits.
+
+use crate::experiment::StudyPoint;
+use plotters::prelude::*;
+
+/// Renders the camera study as an SVG string (two panels: scatter, bias).
+pub fn camera_study_svg(points: &[StudyPoint], title: &str) -> Result<String, String> {
+    let mut cameras: Vec<&str> = Vec::new();
+    for p in points {
+        if !cameras.contains(&p.camera.as_str()) {
+            cameras.push(&p.camera);
+        }
+    }
+    let ok = |p: &&StudyPoint| p.scatter.is_finite() && p.scatter > 0.0;
+    let v_min = points
+        .iter()
+        .map(|p| p.v_n_m_s)
+        .fold(f64::INFINITY, f64::min);
+    let v_max = points.iter().map(|p| p.v_n_m_s).fold(0.0, f64::max);
+    let s_min = points
+        .iter()
+        .filter(ok)
+        .map(|p| 100.0 * p.scatter)
+        .fold(f64::INFINITY, f64::min);
+    let s_max = points
+        .iter()
+        .filter(ok)
+        .map(|p| 100.0 * p.scatter)
+        .fold(0.0, f64::max);
+    let b_abs = points
+        .iter()
+        .filter(ok)
+        .map(|p| (100.0 * p.bias).abs())
+        .fold(0.5, f64::max);
+    if !(v_min > 0.0 && s_min > 0.0 && s_max >= s_min) {
+        return Err("camera study: no measurable point to draw".into());
+    }
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1300, 620)).into_drawing_area();
+        let e = |e: DrawingAreaErrorKind<_>| format!("drawing camera_study.svg: {e}");
+        root.fill(&WHITE).map_err(e)?;
+        let root = root.titled(title, ("sans-serif", 26)).map_err(e)?;
+        let (left, right) = root.split_horizontally(650);
+        let x_range = (v_min / 1.3..v_max * 1.3).log_scale();
+        let mut scatter = ChartBuilder::on(&left)
+            .margin(15)
+            .x_label_area_size(60)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x_range.clone(), (s_min / 1.5..s_max * 1.5).log_scale())
+            .map_err(e)?;
+        scatter
+            .configure_mesh()
+            .x_desc("normal impact speed v_n (m/s)")
+            .y_desc("scatter of e_measured / e_true (%)")
+            .axis_desc_style(("sans-serif", 22))
+            .label_style(("sans-serif", 18))
+            .draw()
+            .map_err(e)?;
+        let mut bias = ChartBuilder::on(&right)
+            .margin(15)
+            .x_label_area_size(60)
+            .y_label_area_size(80)
+            .build_cartesian_2d(x_range, -1.2 * b_abs..1.2 * b_abs)
+            .map_err(e)?;
+        bias.configure_mesh()
+            .x_desc("normal impact speed v_n (m/s)")
+            .y_desc("bias of e_measured / e_true (%)")
+            .axis_desc_style(("sans-serif", 22))
+            .label_style(("sans-serif", 18))
+            .draw()
+            .map_err(e)?;
+        bias.draw_series(LineSeries::new(
+            [(v_min / 1.3, 0.0), (v_max * 1.3, 0.0)],
+            BLACK.mix(0.4),
+        ))
+        .map_err(e)?;
+        for (i, cam) in cameras.iter().enumerate() {
+            let colour = super::colour(i);
+            for fit in ["free", "fixed_gravity"] {
+                let series: Vec<&StudyPoint> = points
+                    .iter()
+                    .filter(|p| p.camera == *cam && p.fit == fit)
+                    .filter(ok)
+                    .collect();
+                let s: Vec<(f64, f64)> = series
+                    .iter()
+                    .map(|p| (p.v_n_m_s, 100.0 * p.scatter))
+                    .collect();
+                let b: Vec<(f64, f64)> =
+                    series.iter().map(|p| (p.v_n_m_s, 100.0 * p.bias)).collect();
+                let style = colour.stroke_width(2);
+                if fit == "free" {
+                    scatter
+                        .draw_series(LineSeries::new(s.clone(), style))
+                        .map_err(e)?
+                        .label(cam.to_string())
+                        .legend(move |(x, y)| {
+                            PathElement::new([(x, y), (x + 24, y)], colour.stroke_width(3))
+                        });
+                    bias.draw_series(LineSeries::new(b.clone(), style))
+                        .map_err(e)?;
+                } else {
+                    scatter
+                        .draw_series(DashedLineSeries::new(s.clone(), 8, 5, style))
+                        .map_err(e)?;
+                    bias.draw_series(DashedLineSeries::new(b.clone(), 8, 5, style))
+                        .map_err(e)?;
+                }
+                scatter
+                    .draw_series(
+                        s.iter()
+                            .map(|&(x, y)| Circle::new((x, y), 4, colour.filled())),
+                    )
+                    .map_err(e)?;
+                bias.draw_series(
+                    b.iter()
+                        .map(|&(x, y)| Circle::new((x, y), 4, colour.filled())),
+                )
+                .map_err(e)?;
+            }
+        }
+        // Legend entries for the line styles.
+        scatter
+            .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+            .map_err(e)?
+            .label("solid: free quadratic fits")
+            .legend(|(x, y)| PathElement::new([(x, y), (x + 24, y)], BLACK.stroke_width(2)));
+        scatter
+            .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+            .map_err(e)?
+            .label("dashed: fixed-gravity fits")
+            .legend(|(x, y)| {
+                EmptyElement::at((x, y))
+                    + PathElement::new([(0, 0), (7, 0)], BLACK.stroke_width(2))
+                    + PathElement::new([(11, 0), (18, 0)], BLACK.stroke_width(2))
+                    + PathElement::new([(22, 0), (26, 0)], BLACK.stroke_width(2))
+            });
+        scatter
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font(("sans-serif", 17))
+            .background_style(WHITE.mix(0.9))
+            .border_style(BLACK.mix(0.5))
+            .draw()
+            .map_err(e)?;
+        root.present().map_err(e)?;
+    }
+    Ok(svg)
+}

@@ -1,0 +1,422 @@
+//! `restitution fit` as a user runs it: the shipped example, the JSON shape, `--out`, and one
+//! clear error (file, line, column, value; non-zero exit; no output files) per bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+const BIN: &str = env!("CARGO_BIN_EXE_restitution");
+
+struct Run {
+    ok: bool,
+    stdout: String,
+    stderr: String,
+}
+
+fn run(args: &[&str]) -> Run {
+    let out = Command::new(BIN)
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .expect("binary runs");
+    Run {
+        ok: out.status.success(),
+        stdout: String::from_utf8_lossy(&out.stdout).into(),
+        stderr: String::from_utf8_lossy(&out.stderr).into(),
+    }
+}
+
+/// A fresh scratch directory for one test.
+fn scratch(tag: &str) -> PathBuf {
+    static N: AtomicUsize = AtomicUsize::new(0);
+    let d = std::env::temp_dir().join(format!(
+        "restitution-fit-cli-{}-{}-{tag}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::SeqCst)
+    ));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.to_string_lossy().into()
+}
+
+fn keys(v: &serde_json::Value) -> Vec<String> {
+    v.as_object().expect("an object").keys().cloned().collect()
+}
+
+#[test]
+fn shipped_example_prefers_the_regime_switch() {
+    // data/fig7_nylon.csv was made with min(e_vm, e_pm), eta = 190, sigma_y = 4.0e7
+    // (examples/gen_fig7_data.rs): the comparison must name `min`, and the planted values must lie
+    // inside its 95% intervals (the shipped realisation; a 5% chance each of missing was checked
+    // when the data were made, not tuned for).
+    let r = run(&[
+        "fit",
+        "data/fig7_nylon.csv",
+        "--material",
+        "nylon",
+        "--format",
+        "json",
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    assert_eq!(v["preferred"], "min");
+    assert_eq!(v["data"]["n"], 120);
+    let min = v["fits"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|f| f["model"] == "min")
+        .unwrap();
+    for (key, truth) in [("eta", 190.0), ("sigma_y", 4.0e7)] {
+        let ci = &min["params"][key]["ci95"];
+        let (lo, hi) = (ci[0].as_f64().unwrap(), ci[1].as_f64().unwrap());
+        assert!(lo <= truth && truth <= hi, "{key}: [{lo}, {hi}]");
+    }
+    // e > 1 rows are a warning, not an error.
+    assert!(
+        r.stderr.contains("warning") && r.stderr.contains("above 1"),
+        "{}",
+        r.stderr
+    );
+}
+
+#[test]
+fn json_shape_is_stable() {
+    let r = run(&[
+        "fit",
+        "data/wall_example.csv",
+        "--material",
+        "nylon",
+        "--format",
+        "json",
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    assert_eq!(
+        keys(&v),
+        [
+            "data",
+            "material",
+            "contact_end",
+            "vm_method",
+            "fits",
+            "comparison",
+            "preferred",
+            "preferred_rule",
+            "skipped_models"
+        ]
+    );
+    assert_eq!(keys(&v["data"]), ["path", "n", "diameters_mm", "errors"]);
+    assert_eq!(
+        keys(&v["material"]),
+        ["youngs_pa", "poisson", "density_kg_m3"]
+    );
+    assert_eq!(v["contact_end"], "overlap");
+    let fits = v["fits"].as_array().unwrap();
+    let models: Vec<&str> = fits.iter().map(|f| f["model"].as_str().unwrap()).collect();
+    assert_eq!(models, ["vm", "pm", "min", "product", "powerlaw"]);
+    for f in fits {
+        let mut expected = vec!["model", "formula"];
+        if f["model"] == "powerlaw" {
+            expected.push("constants");
+        }
+        expected.extend([
+            "params",
+            "derived",
+            "correlation",
+            "chi2",
+            "dof",
+            "reduced_chi2",
+            "aic",
+            "aicc",
+            "bic",
+            "weighted",
+            "ci95_delta_chi2",
+            "converged",
+            "evaluations",
+            "profile_evaluations",
+            "notes",
+        ]);
+        assert_eq!(keys(f), expected);
+        for (_, p) in f["params"].as_object().unwrap() {
+            assert_eq!(
+                keys(p),
+                [
+                    "value",
+                    "stderr",
+                    "stderr_abs",
+                    "ci95",
+                    "unit",
+                    "status",
+                    "best_fit"
+                ]
+            );
+            assert_eq!(p["ci95"].as_array().unwrap().len(), 2);
+        }
+        assert!(f["chi2"].is_f64() && f["dof"].is_u64() && f["converged"].is_boolean());
+    }
+    let vm = &fits[0];
+    assert_eq!(keys(&vm["params"]), ["eta"]);
+    assert_eq!(vm["params"]["eta"]["unit"], "kg/(s m)");
+    assert!(vm["derived"]["A_s"].is_f64());
+    assert_eq!(keys(&fits[2]["params"]), ["eta", "sigma_y"]);
+    assert_eq!(keys(&fits[4]["params"]), ["A", "a", "b"]);
+    // The wall data stay below V_Y: sigma_y of `min` is a bound, its value null.
+    let sy = &fits[2]["params"]["sigma_y"];
+    assert_eq!(sy["status"], "lower_bound");
+    assert!(sy["value"].is_null() && sy["stderr"].is_null() && sy["ci95"][1].is_null());
+    let row = &v["comparison"][0];
+    assert_eq!(
+        keys(row),
+        [
+            "model",
+            "k",
+            "chi2",
+            "reduced_chi2",
+            "aic",
+            "bic",
+            "delta_aic",
+            "akaike_weight",
+            "converged"
+        ]
+    );
+    assert_eq!(v["preferred"], "vm");
+    assert_eq!(v["skipped_models"], serde_json::json!([]));
+    // Too few points for some models: they are listed, the others fitted.
+    let dir = scratch("few");
+    let path = write(
+        &dir,
+        "two.csv",
+        "d_mm,v_n_m_s,e,e_err\n12.7,1,0.95,0.01\n12.7,2,0.94,0.01\n",
+    );
+    let r = run(&["fit", &path, "--material", "nylon", "--format", "json"]);
+    assert!(r.ok, "{}", r.stderr);
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    assert_eq!(
+        v["skipped_models"],
+        serde_json::json!(["min", "product", "powerlaw"])
+    );
+    assert_eq!(v["fits"].as_array().unwrap().len(), 2);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn out_writes_all_files_and_they_agree_with_stdout() {
+    let dir = scratch("out");
+    let out = dir.join("report");
+    let r = run(&[
+        "fit",
+        "data/wall_example.csv",
+        "--material",
+        "nylon",
+        "--out",
+        out.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    for f in [
+        "params.md",
+        "params.csv",
+        "params.json",
+        "fig7.svg",
+        "residuals.svg",
+    ] {
+        let text = std::fs::read_to_string(out.join(f)).unwrap();
+        assert!(!text.is_empty(), "{f}");
+        if f.ends_with(".svg") {
+            assert!(text.contains("<svg") && text.contains("normal impact speed v_n (m/s)"));
+        }
+    }
+    assert_eq!(
+        std::fs::read_to_string(out.join("params.json")).unwrap(),
+        r.stdout
+    );
+    let csv = std::fs::read_to_string(out.join("params.csv")).unwrap();
+    assert!(csv.starts_with("model,parameter,unit,status,value,stderr,stderr_abs,ci95_low"));
+    // No temporary files left behind.
+    let names: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into())
+        .collect();
+    assert_eq!(names.len(), 5, "{names:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn each_bad_input_gets_one_clear_error_and_no_output() {
+    let dir = scratch("bad");
+    // Comments and a blank line first: the error lines must count them.
+    let head = "# measured 1997\n\nd_mm,v_n_m_s,e,e_err\n# a comment\n";
+    let good = "12.7,1.0,0.95,0.01\n6.35,2.0,0.90,0.01\n";
+    let cases: Vec<(&str, String, &str)> = vec![
+        (
+            "not_a_number",
+            format!("{head}{good}12.7,3.0,abc,0.01\n"),
+            ":7: column 'e': 'abc' is not a number",
+        ),
+        (
+            "nan",
+            format!("{head}{good}12.7,nan,0.9,0.01\n"),
+            ":7: column 'v_n_m_s': 'nan' is not a finite number",
+        ),
+        (
+            "infinite",
+            format!("{head}12.7,1.0,inf,0.01\n{good}"),
+            ":5: column 'e': 'inf' is not a finite number",
+        ),
+        (
+            "speed_not_positive",
+            format!("{head}{good}12.7,0,0.9,0.01\n"),
+            ":7: column 'v_n_m_s': '0' is out of range: expected a speed > 0 (m/s)",
+        ),
+        (
+            "e_negative",
+            format!("{head}{good}12.7,3.0,-0.2,0.01\n"),
+            ":7: column 'e': '-0.2' is out of range: expected e >= 0",
+        ),
+        (
+            "d_not_positive",
+            format!("{head}{good}-6.35,3.0,0.9,0.01\n"),
+            ":7: column 'd_mm': '-6.35' is out of range: expected a diameter > 0 (mm)",
+        ),
+        (
+            "e_err_not_positive",
+            format!("{head}{good}12.7,3.0,0.9,0\n"),
+            ":7: column 'e_err': '0' is out of range: expected an error > 0",
+        ),
+        (
+            "missing_column",
+            "# x\nd_mm,e\n12.7,0.9\n".to_string(),
+            ":2: column 'v_n_m_s': required column is missing",
+        ),
+        (
+            "no_rows",
+            format!("{head}\n# nothing measured\n"),
+            ":3: no data rows after the header",
+        ),
+        (
+            "field_count",
+            format!("{head}{good}12.7,3.0,0.9\n"),
+            ":7: has 3 fields, the header has 4",
+        ),
+        (
+            "v_err_not_positive",
+            "d_mm,v_n_m_s,e,v_err_m_s\n12.7,1,0.9,0.04\n12.7,2,0.9,-0.04\n".to_string(),
+            ":3: column 'v_err_m_s': '-0.04' is out of range",
+        ),
+        (
+            "wall_diameter",
+            "d_mm,d2_mm,v_n_m_s,e\n12.7,inf,1,0.9\n12.7,0,2,0.9\n".to_string(),
+            ":3: column 'd2_mm': '0' is out of range: expected a number > 0, or inf for a flat wall",
+        ),
+    ];
+    for (name, text, expected) in cases {
+        let path = write(&dir, &format!("{name}.csv"), &text);
+        let out = dir.join(format!("{name}_out"));
+        let r = run(&[
+            "fit",
+            &path,
+            "--material",
+            "nylon",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(!r.ok, "{name}: exit 0");
+        assert!(r.stdout.is_empty(), "{name}: stdout {}", r.stdout);
+        let lines: Vec<&str> = r.stderr.lines().collect();
+        assert_eq!(lines.len(), 1, "{name}: {}", r.stderr);
+        assert!(
+            lines[0].starts_with("restitution: error: ") && lines[0].contains(&path),
+            "{name}: {}",
+            lines[0]
+        );
+        assert!(lines[0].contains(expected), "{name}: {}", lines[0]);
+        assert!(!out.exists(), "{name}: output written");
+    }
+    // A missing file and a missing material are errors too.
+    let r = run(&["fit", "no/such/file.csv", "--material", "nylon"]);
+    assert!(!r.ok && r.stderr.contains("no/such/file.csv") && r.stderr.contains("cannot read"));
+    let path = write(&dir, "ok.csv", &format!("{head}{good}12.7,3,0.9,0.01\n"));
+    let r = run(&["fit", &path]);
+    assert!(
+        !r.ok && r.stderr.contains("a material is needed"),
+        "{}",
+        r.stderr
+    );
+    let r = run(&["fit", &path, "--material", "nylon", "--model", "quadratic"]);
+    assert!(!r.ok && r.stderr.lines().count() == 1, "{}", r.stderr);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn suspicious_values_warn_and_strict_makes_them_errors() {
+    let dir = scratch("strict");
+    let text = "d_mm,v_n_m_s,e,e_err\n12.7,1,1.03,0.05\n12.7,2,0.95,0.01\n0.00635,3,0.9,0.01\n12.7,4,1.01,0.05\n";
+    let path = write(&dir, "s.csv", text);
+    let r = run(&["fit", &path, "--material", "nylon", "--model", "vm"]);
+    assert!(r.ok, "{}", r.stderr);
+    let warnings: Vec<&str> = r.stderr.lines().collect();
+    assert_eq!(warnings.len(), 2, "{}", r.stderr);
+    assert!(warnings[0].contains(":4: column 'd_mm': '0.00635' is below 0.1 mm"));
+    assert!(
+        warnings[1].contains(":2: column 'e': '1.03' is above 1")
+            && warnings[1].contains("and 1 more row")
+    );
+    let out = dir.join("o");
+    let r = run(&[
+        "fit",
+        &path,
+        "--material",
+        "nylon",
+        "--strict",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(!r.ok);
+    assert_eq!(r.stderr.lines().count(), 1, "{}", r.stderr);
+    assert!(
+        r.stderr.contains(":2: column 'e': '1.03' is above 1") && r.stderr.contains("--strict")
+    );
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn exact_and_master_agree_through_the_cli() {
+    // The same fit with the ODE for every point: eta agrees to 1e-7 (see tests/fit.rs for why).
+    let get = |extra: &[&str]| {
+        let mut args = vec![
+            "fit",
+            "data/wall_example.csv",
+            "--material",
+            "nylon",
+            "--model",
+            "vm",
+            "--format",
+            "json",
+        ];
+        args.extend(extra);
+        let r = run(&args);
+        assert!(r.ok, "{}", r.stderr);
+        let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+        (
+            v["fits"][0]["params"]["eta"]["value"].as_f64().unwrap(),
+            v["vm_method"].as_str().unwrap().to_string(),
+        )
+    };
+    let (m, mname) = get(&[]);
+    let (o, oname) = get(&["--exact"]);
+    assert_eq!(mname, "master curve");
+    assert!(oname.starts_with("ODE dop853"), "{oname}");
+    assert!((m / o - 1.0).abs() < 1e-7, "{m} {o}");
+    // The force rule is a different model: a different eta.
+    let (f, _) = get(&["--contact-end", "force"]);
+    assert!((f / m - 1.0).abs() > 1e-3, "{f} {m}");
+}
