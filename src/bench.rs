@@ -16,6 +16,7 @@
 //! ([`timing`]); rhs_evals counts right-hand-side calls of the ODE (integrand calls for the
 //! quadrature), including those spent locating events.
 
+pub mod fit_accuracy;
 pub mod methods;
 pub mod quadrature;
 pub mod reference;
@@ -25,8 +26,11 @@ pub mod work_precision;
 
 use crate::data::fmt_num;
 use crate::error::Result;
+use crate::fit::FitData;
+use crate::models::viscoelastic::VmMethod;
 use crate::models::viscoelastic::series::{Approximation, Pade, Series};
 use crate::models::viscoelastic::{ContactEnd, Integrator, OdeSettings};
+use fit_accuracy::FitAccuracy;
 pub use methods::{PmResult, PmSpec, VmSpec};
 use quadrature::WorkQuadrature;
 use reference::{PmRef, ReferenceCheck, VmRef, pm_fixture, vm_dense_reference, vm_fixture};
@@ -100,6 +104,36 @@ impl BenchConfig {
                 min_batch: Duration::from_millis(3),
             }
         }
+    }
+
+    /// The evaluation methods of the fit-accuracy comparison.
+    pub fn fit_methods(&self) -> Vec<VmMethod> {
+        let dop853: Vec<f64> = if self.quick {
+            vec![1e-4, 1e-6, 1e-8, 1e-10, 1e-12]
+        } else {
+            (3..=12).map(|k| 10f64.powi(-k)).collect()
+        };
+        let dopri5: Vec<f64> = if self.quick {
+            vec![1e-6, 1e-9, 1e-12]
+        } else {
+            (3..=12).map(|k| 10f64.powi(-k)).collect()
+        };
+        let rk4: Vec<f64> = if self.quick {
+            vec![0.0125]
+        } else {
+            vec![0.05, 0.0125, 0.003125]
+        };
+        let mut v = vec![VmMethod::Master];
+        let ode = |i: Integrator, t: f64| VmMethod::Ode(OdeSettings::with_integrator(i, t));
+        v.extend(dop853.iter().map(|&t| ode(Integrator::Dop853, t)));
+        v.extend(dopri5.iter().map(|&t| ode(Integrator::Dopri5, t)));
+        v.extend(rk4.iter().map(|&h| ode(Integrator::Rk4 { h }, 0.0)));
+        v
+    }
+
+    /// Repeats of each fit (the fastest counts).
+    pub fn fit_repeats(&self) -> usize {
+        if self.quick { 1 } else { 3 }
     }
 
     /// Stability-map points per decade of kappa.
@@ -255,6 +289,8 @@ pub struct BenchReport {
     pub candidates: Vec<OdeCandidate>,
     /// The targets' methods timed point by point (the chart's figures are means over points).
     pub per_point: Vec<PointTiming>,
+    /// What accuracy a fit needs (when a data set was given).
+    pub fit: Option<FitAccuracy>,
 }
 
 /// The time of one method at one point.
@@ -308,8 +344,9 @@ pub fn per_point_timing(
     out
 }
 
-/// Runs the whole bench. Fails only if a reference value cannot be computed.
-pub fn run(cfg: &BenchConfig) -> Result<BenchReport> {
+/// Runs the whole bench; with `fit_data`, also the fit-accuracy comparison on it (overlap rule).
+/// Fails only if a reference value (or the reference fit) cannot be computed.
+pub fn run(cfg: &BenchConfig, fit_data: Option<&FitData>) -> Result<BenchReport> {
     let plan = cfg.timing();
     let vm_refs = chart_vm_points();
     let mut rows = Vec::new();
@@ -344,6 +381,18 @@ pub fn run(cfg: &BenchConfig) -> Result<BenchReport> {
     let reference_check = reference::check_ode_reference()?;
     let candidates = ode_candidates(&kappas, &vm_refs, &plan)?;
     let per_point = per_point_timing(&vm_refs, &pm_refs, &plan);
+    let fit = match fit_data {
+        Some(data) => Some(fit_accuracy::fit_accuracy(
+            data,
+            ContactEnd::Overlap,
+            &cfg.fit_methods(),
+            &TimingPlan {
+                repeats: cfg.fit_repeats(),
+                min_batch: Duration::ZERO,
+            },
+        )?),
+        None => None,
+    };
     Ok(BenchReport {
         config: *cfg,
         rows,
@@ -353,6 +402,7 @@ pub fn run(cfg: &BenchConfig) -> Result<BenchReport> {
         rk4_order,
         candidates,
         per_point,
+        fit,
     })
 }
 
@@ -507,6 +557,35 @@ impl BenchReport {
                 csv_num(c.error),
                 csv_text(&c.detail)
             );
+        }
+        s
+    }
+
+    /// `fit_accuracy.csv`: one row per evaluation method (header only without a data set).
+    pub fn fit_accuracy_csv(&self) -> String {
+        let mut s = String::from(
+            "method,setting,knob,eta,eta_rel_error,fit_ms,evaluations,model_error,threshold,meets,default,converged,failure\n",
+        );
+        if let Some(f) = &self.fit {
+            for (i, r) in f.rows.iter().enumerate() {
+                let _ = writeln!(
+                    s,
+                    "{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                    csv_text(&r.method),
+                    csv_text(&r.setting),
+                    csv_num(r.knob),
+                    csv_num(r.eta),
+                    csv_num(r.eta_rel_error),
+                    csv_num(r.fit_ms),
+                    r.evaluations,
+                    csv_num(r.model_error),
+                    csv_num(f.threshold),
+                    r.meets,
+                    f.default_row == Some(i),
+                    r.converged,
+                    csv_text(r.failure.as_deref().unwrap_or(""))
+                );
+            }
         }
         s
     }
@@ -799,6 +878,45 @@ impl BenchReport {
                 c.rhs_evals,
                 if c.meets_bar() { "yes" } else { "no" }
             );
+        }
+        if let Some(f) = &self.fit {
+            let _ = writeln!(s, "\n## What accuracy a fit needs\n");
+            let _ = writeln!(
+                s,
+                "Model `vm` (overlap rule) fitted to the example data set ({} points, kappa {}..{} at the fitted eta), each evaluation method against the fit with the ODE at tol 1e-15 (eta = {} kg/(s m), standard error {} = {} relative; {:.0} ms). Rule: model error (max |e - e_ref| over the data) <= {} x the smallest error bar ({}) = {}.\n",
+                f.n_points,
+                sci(f.kappa_range.0),
+                sci(f.kappa_range.1),
+                fmt_num(f.eta_ref),
+                sci(f.eta_ref_stderr),
+                sci(f.eta_ref_stderr / f.eta_ref),
+                f.reference_fit_ms,
+                fit_accuracy::SIGMA_FRACTION,
+                sci(f.min_sigma),
+                sci(f.threshold)
+            );
+            let _ = writeln!(
+                s,
+                "| method | setting | eta rel. error | fit ms | model error | meets | note |\n|---|---|---|---|---|---|---|"
+            );
+            for (i, r) in f.rows.iter().enumerate() {
+                let note = if f.default_row == Some(i) {
+                    "**default: cheapest that meets the rule**".to_string()
+                } else {
+                    r.failure.clone().unwrap_or_default()
+                };
+                let _ = writeln!(
+                    s,
+                    "| {} | {} | {} | {:.2} | {} | {} | {} |",
+                    r.method,
+                    r.setting,
+                    sci(r.eta_rel_error),
+                    r.fit_ms,
+                    sci(r.model_error),
+                    if r.meets { "yes" } else { "no" },
+                    note.replace('|', "/")
+                );
+            }
         }
         let _ = writeln!(
             s,

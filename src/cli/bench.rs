@@ -3,19 +3,26 @@
 //! ```text
 //! restitution bench [--out DIR] [--quick]
 //! ```
-//! Writes into DIR (default `reports/bench`, created if missing), all seven files or none:
+//! Writes into DIR (default `reports/bench`, created if missing), all nine files or none:
 //! `work_precision.csv` (model,method,setting,knob,rule,error,error_rel_e,error_rel_one_minus_e,
 //! ns_per_eval,rhs_evals,points,failed), `work_precision_points.csv` (every evaluation behind it),
 //! `work_precision.svg`, `stability.csv`, `stability.svg` and `summary.md` (targets, RK4 order,
-//! default-setting candidates, where each method fails) and `timing_per_point.csv` (the targets'
-//! methods timed at each point alone). Prints the summary. `--quick` measures
+//! default-setting candidates, where each method fails, what accuracy a fit needs),
+//! `timing_per_point.csv` (the targets' methods timed at each point alone), `fit_accuracy.csv` and
+//! `fit_accuracy.svg` (model `vm` fitted to the example data set `data/fig7_nylon.csv`, compiled
+//! in, with each evaluation method). Prints the summary. `--quick` measures
 //! fewer settings and points with shorter timing batches (well under a minute).
 
 use super::CliResult;
 use restitution::bench::{self, BenchConfig};
+use restitution::contact::Material;
 use restitution::data::write_all_atomic;
+use restitution::fit::input::parse_fit_csv;
 use restitution::plot;
 use std::path::PathBuf;
+
+const EXAMPLE_PATH: &str = "data/fig7_nylon.csv";
+const EXAMPLE_DATA: &str = include_str!("../../data/fig7_nylon.csv");
 
 /// Speed against accuracy: work-precision chart, stability map, targets
 #[derive(clap::Args, Debug)]
@@ -60,7 +67,11 @@ pub fn run(args: Args) -> CliResult {
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("--out {}: cannot create directory: {e}", args.out.display()))?;
     let load_before = load_average();
-    let report = bench::run(&cfg).map_err(|e| e.to_string())?;
+    // The example data set of `restitution fit` (synthetic Fig. 7 nylon data), compiled in.
+    let nylon = Material::preset("nylon").expect("the nylon preset exists");
+    let example =
+        parse_fit_csv(EXAMPLE_PATH, EXAMPLE_DATA, nylon, false).map_err(|e| e.to_string())?;
+    let report = bench::run(&cfg, Some(&example.data)).map_err(|e| e.to_string())?;
     let machine = format!(
         "{}; load average (1 min) {} before, {} after (other processes share the CPUs when it is above 0)",
         machine(),
@@ -72,6 +83,8 @@ pub fn run(args: Args) -> CliResult {
         .map_err(|e| format!("drawing work_precision.svg: {e}"))?;
     let st_svg =
         plot::bench::stability_svg(&report).map_err(|e| format!("drawing stability.svg: {e}"))?;
+    let fit_svg = plot::bench::fit_accuracy_svg(&report)
+        .map_err(|e| format!("drawing fit_accuracy.svg: {e}"))?;
     let files = vec![
         (
             args.out.join("work_precision.csv"),
@@ -91,6 +104,11 @@ pub fn run(args: Args) -> CliResult {
             args.out.join("timing_per_point.csv"),
             report.per_point_csv().into_bytes(),
         ),
+        (
+            args.out.join("fit_accuracy.csv"),
+            report.fit_accuracy_csv().into_bytes(),
+        ),
+        (args.out.join("fit_accuracy.svg"), fit_svg.into_bytes()),
         (args.out.join("summary.md"), summary.clone().into_bytes()),
     ];
     write_all_atomic(&files).map_err(|e| format!("writing into {}: {e}", args.out.display()))?;

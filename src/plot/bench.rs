@@ -1,5 +1,6 @@
 //! Figures of `restitution bench`: the work-precision chart (four panels) and the stability map.
 
+use crate::bench::fit_accuracy::FitMethodRow;
 use crate::bench::stability::{Cell, Outcome};
 use crate::bench::{BenchReport, WpRow};
 use plotters::coord::Shift;
@@ -594,6 +595,140 @@ pub fn stability_svg(report: &BenchReport) -> Result<String, String> {
                     (x + 34, y + 2),
                     ("sans-serif", 18).into_font(),
                 ))
+                .map_err(err_str)?;
+        }
+        root.present().map_err(err_str)?;
+    }
+    Ok(svg)
+}
+
+/// Title, y label, y value, reference line and its label of a fit-accuracy panel.
+type PanelSpec = (
+    &'static str,
+    &'static str,
+    fn(&FitMethodRow) -> f64,
+    f64,
+    String,
+);
+
+/// `fit_accuracy.svg`: (a) the fitted eta's error and (b) the model error over the data, against
+/// the fit's wall time, per evaluation method; the default (cheapest method whose model error is
+/// below 1% of the smallest error bar) ringed.
+pub fn fit_accuracy_svg(report: &BenchReport) -> Result<String, String> {
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (1600, 700)).into_drawing_area();
+        root.fill(&WHITE).map_err(err_str)?;
+        let Some(f) = &report.fit else {
+            root.titled("no fit data set given", ("sans-serif", 22))
+                .map_err(err_str)?;
+            root.present().map_err(err_str)?;
+            drop(root);
+            return Ok(svg);
+        };
+        let (title, body) = root.split_vertically(50);
+        title
+            .titled(
+                &format!(
+                    "What accuracy a fit needs: model vm on the example data ({} points) per evaluation method, against the fit at ODE tol 1e-15 (failed fits left out: fit_accuracy.csv)",
+                    f.n_points
+                ),
+                ("sans-serif", 22),
+            )
+            .map_err(err_str)?;
+        let panels = body.split_evenly((1, 2));
+        let ok: Vec<(usize, &FitMethodRow)> = f
+            .rows
+            .iter()
+            .enumerate()
+            .filter(|(_, r)| r.failure.is_none())
+            .collect();
+        let x = range_of(ok.iter().map(|(_, r)| r.fit_ms), 2.0);
+        for (panel, which) in panels.iter().zip([0, 1]) {
+            let (title, y_desc, y_of, line, line_label): PanelSpec = if which == 0 {
+                (
+                    "(a) fitted eta: relative error vs fit time",
+                    "|eta - eta_ref| / eta_ref",
+                    |r| r.eta_rel_error,
+                    f.eta_ref_stderr / f.eta_ref,
+                    "eta's own standard error (the data's limit)".to_string(),
+                )
+            } else {
+                (
+                    "(b) model error over the data vs fit time",
+                    "max |e - e_ref| over the data",
+                    |r| r.model_error,
+                    f.threshold,
+                    format!(
+                        "{} x smallest error bar = {:.1e}",
+                        crate::bench::fit_accuracy::SIGMA_FRACTION,
+                        f.threshold
+                    ),
+                )
+            };
+            let y = (
+                ERROR_FLOOR / 3.0,
+                range_of(ok.iter().map(|(_, r)| y_of(r)).chain([line]), 10.0).1,
+            );
+            let mut chart = log_panel(panel, title, "fit wall time (ms)", y_desc, x, y)?;
+            let rows: Vec<WpRow> = ok
+                .iter()
+                .map(|(_, r)| WpRow {
+                    model: "vm",
+                    method: r.method.clone(),
+                    setting: r.setting.clone(),
+                    knob: r.knob,
+                    rule: "overlap".into(),
+                    error: y_of(r),
+                    error_rel_e: f64::NAN,
+                    error_rel_one_minus_e: f64::NAN,
+                    ns_per_eval: r.fit_ms,
+                    rhs_evals: f64::NAN,
+                    points: 0,
+                    failed: 0,
+                })
+                .collect();
+            let refs: Vec<&WpRow> = rows.iter().collect();
+            draw_lines(&mut chart, &refs, |r| r.ns_per_eval, |r| r.error, false, "")?;
+            let gstyle = ShapeStyle::from(&RGBColor(120, 120, 120)).stroke_width(2);
+            chart
+                .draw_series(DashedLineSeries::new(
+                    vec![(x.0, line), (x.1, line)],
+                    8,
+                    5,
+                    gstyle,
+                ))
+                .map_err(err_str)?
+                .label(line_label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], gstyle));
+            if let Some(d) = f.default_row.map(|i| &f.rows[i]) {
+                let p = (d.fit_ms, floor(y_of(d)));
+                chart
+                    .draw_series(std::iter::once(Circle::new(
+                        p,
+                        11,
+                        ShapeStyle::from(&BLACK).stroke_width(2),
+                    )))
+                    .map_err(err_str)?;
+                let style = ("sans-serif", 17)
+                    .into_font()
+                    .into_text_style(panel)
+                    .pos(Pos::new(HPos::Left, VPos::Bottom));
+                chart
+                    .draw_series(std::iter::once(Text::new(
+                        format!("  default: {} {}", d.method, d.setting),
+                        p,
+                        style,
+                    )))
+                    .map_err(err_str)?;
+            }
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::LowerRight)
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .label_font(("sans-serif", 17))
+                .draw()
                 .map_err(err_str)?;
         }
         root.present().map_err(err_str)?;
