@@ -213,6 +213,14 @@ pub fn vm_map_specs() -> Vec<(VmSpec, Role)> {
             p,
         ),
         (
+            VmSpec::Ode(OdeSettings::with_integrator(Integrator::Dop853, 1e-3)),
+            Role::Loose,
+        ),
+        (
+            VmSpec::Ode(OdeSettings::with_integrator(Integrator::Dopri5, 1e-3)),
+            Role::Loose,
+        ),
+        (
             VmSpec::Checked(Approximation::Series(Series::Order2), stability::MAP_TOL),
             p,
         ),
@@ -549,6 +557,7 @@ impl BenchReport {
                 match c.role {
                     Role::Production => "production",
                     Role::Comparator => "comparator",
+                    Role::Loose => "loose",
                 },
                 c.rule,
                 if c.model == "vm" { "kappa" } else { "u" },

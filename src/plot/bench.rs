@@ -384,7 +384,7 @@ fn outcome_label(o: Outcome) -> &'static str {
     use crate::error::IntegrationFailure as F;
     match o {
         Outcome::Ok => "ok (error <= 1e-6)",
-        Outcome::Inaccurate => "WRONG NUMBER: error > 1e-6, no error value",
+        Outcome::Inaccurate => "WRONG NUMBER: error > 1e-6 (loose rows: 100 tol), no error value",
         Outcome::NotFinite => "WRONG NUMBER: NaN, no error value",
         Outcome::Refused => "refused: error bound above 1e-6 (error value)",
         Outcome::Failed(F::MaxSteps) => "no termination: step budget spent (error value)",
@@ -422,10 +422,10 @@ fn row_key(c: &Cell) -> String {
     } else {
         format!(" [{}]", c.rule)
     };
-    let role = if c.role == crate::bench::stability::Role::Comparator {
-        " (comparator)"
-    } else {
-        ""
+    let role = match c.role {
+        crate::bench::stability::Role::Comparator => " (comparator)",
+        crate::bench::stability::Role::Loose => " (loose: 100 tol)",
+        crate::bench::stability::Role::Production => "",
     };
     format!("{}{setting}{rule}{role}", c.method)
 }
