@@ -246,7 +246,7 @@ mod tests {
     fn numbers_are_classified_by_the_combined_error() {
         // 1 - e = 1e-8 known to 1e-15 absolute: relative 1e-7, ok.
         assert_eq!(
-            classify_number(1.0 - 1e-8, 1e-8 + 1e-15, 1.0 - 1e-8, 1e-8).0,
+            classify_number(1.0 - 1e-8, 1e-8 + 1e-15, 1.0 - 1e-8, 1e-8, MAP_TOL).0,
             Outcome::Ok
         );
         // 1 - e off by 1e-13 at 1 - e = 1e-8: relative 1e-5, inaccurate.
@@ -255,7 +255,7 @@ mod tests {
             Outcome::Inaccurate
         );
         assert_eq!(
-            classify_number(f64::NAN, 0.5, 0.5, 0.5).0,
+            classify_number(f64::NAN, 0.5, 0.5, 0.5, MAP_TOL).0,
             Outcome::NotFinite
         );
     }
