@@ -300,14 +300,15 @@ fn each_failure_of_the_map_is_an_error_value() {
 
 #[test]
 fn production_methods_never_return_a_wrong_number_on_the_map() {
-    // The map at one point per decade, kappa 1e-8..1e4 (the committed report has four): every
-    // production cell is ok or an error value. The comparators fail silently exactly where the
+    // The map at one point per decade, kappa 1e-8..1e4 (the committed report has twelve): every
+    // production cell is ok or an error value, and so is every loose-tolerance cell held to 100x
+    // its tolerance. The comparators fail silently exactly where the
     // report says: near yield (u - 1 <= 1e-6), where 1 - e cancels.
     let kappas = stability::kappa_grid(1, 4);
     let cells = stability::vm_map(&bench::vm_map_specs(), &kappas).unwrap();
     let silent: Vec<String> = cells
         .iter()
-        .filter(|c| c.role == Role::Production && c.outcome.is_silent_failure())
+        .filter(|c| c.role != Role::Comparator && c.outcome.is_silent_failure())
         .map(|c| {
             format!(
                 "{} {} {} kappa={}: {}",
@@ -326,6 +327,7 @@ fn production_methods_never_return_a_wrong_number_on_the_map() {
     for c in &pm {
         match c.role {
             Role::Production => assert_eq!(c.outcome, Outcome::Ok, "{c:?}"),
+            Role::Loose => panic!("no loose plastic rows: {c:?}"),
             Role::Comparator => {
                 let near_yield = c.x - 1.0 <= 1.5e-6;
                 assert_eq!(
