@@ -19,18 +19,18 @@ const ERROR_FLOOR: f64 = 1e-17;
 /// Relative errors above this (no correct digit left) are drawn at it.
 const REL_ERROR_CAP: f64 = 10.0;
 
+/// Each method's colour, from the figures' shared palette ([`super::PALETTE`]); the reference-
+/// grade methods (master curve, plastic closed form) in black, as the models are elsewhere.
 fn method_color(method: &str) -> RGBColor {
+    use super::PALETTE as P;
     match method {
-        "dop853" => RGBColor(0, 90, 181),
-        "dop853+extrema" => RGBColor(120, 160, 230),
-        "dopri5" => RGBColor(220, 50, 32),
-        "rk4" => RGBColor(0, 150, 60),
-        "master" => RGBColor(0, 0, 0),
-        "series" => RGBColor(230, 140, 0),
-        "pade" => RGBColor(150, 60, 170),
-        "closed form" => RGBColor(0, 0, 0),
-        "naive q" => RGBColor(220, 50, 32),
-        "quadrature" => RGBColor(0, 90, 181),
+        "dop853" | "quadrature" => P[0],
+        "dopri5" | "naive q" => P[1],
+        "rk4" => P[2],
+        "pade" => P[3],
+        "series" => P[4],
+        "dop853+extrema" => P[5],
+        "master" | "closed form" => BLACK,
         _ => RGBColor(100, 100, 100),
     }
 }
@@ -295,8 +295,8 @@ pub fn work_precision_svg(report: &BenchReport) -> Result<String, String> {
             y_d,
         )?;
         for (rule, color, dashed) in [
-            ("overlap", RGBColor(0, 150, 60), false),
-            ("force", RGBColor(0, 90, 40), true),
+            ("overlap", super::PALETTE[2], false),
+            ("force", RGBColor(0, 100, 75), true),
         ] {
             let mut pts: Vec<(f64, f64)> = rk4
                 .iter()
