@@ -422,7 +422,10 @@ pub fn ode_candidates(
     plan: &TimingPlan,
 ) -> Result<Vec<OdeCandidate>> {
     let mut specs = vec![VmSpec::Ode(OdeSettings::DEFAULT)];
-    for tol in [1e-9, 1e-10, 1e-11] {
+    for tol in [1e-9, 1e-10, 1e-11, 1e-12]
+        .into_iter()
+        .filter(|&t| t != OdeSettings::DEFAULT.rtol)
+    {
         specs.push(VmSpec::Ode(OdeSettings::with_integrator(
             Integrator::Dop853,
             tol,
@@ -769,13 +772,16 @@ impl BenchReport {
                 yes(accurate && worst < 100.0)
             );
         }
-        if let Some(d) = self.row("vm", "dop853", "tol=1e-12", "all") {
+        let default_tol = fmt_num(OdeSettings::DEFAULT.rtol);
+        let default_setting = format!("tol={default_tol}");
+        let default_method = format!("dop853 {default_setting}");
+        if let Some(d) = self.row("vm", "dop853", &default_setting, "all") {
             let full = self.candidates.first().map_or(f64::NAN, |c| c.max_abs_e);
             let accurate = d.error <= 1e-10 && full <= 1e-10;
-            let (worst, text) = slowest("dop853 tol=1e-12", 1e3, "us");
+            let (worst, text) = slowest(&default_method, 1e3, "us");
             let _ = writeln!(
                 s,
-                "| default ODE (Dop853, tol 1e-12, e only) < 20 us/eval at error <= 1e-10 | {:.2} us ({:.0} rhs evals) | {text} | {} (kappa 1e-8..100: {}) | {} | {} |",
+                "| default ODE (Dop853, tol {default_tol}, e only) < 20 us/eval at error <= 1e-10 | {:.2} us ({:.0} rhs evals) | {text} | {} (kappa 1e-8..100: {}) | {} | {} |",
                 d.ns_per_eval / 1e3,
                 d.rhs_evals,
                 sci(d.error),
@@ -784,7 +790,7 @@ impl BenchReport {
                 yes(accurate && worst < 20_000.0)
             );
         }
-        if let Some(dx) = self.row("vm", "dop853+extrema", "tol=1e-12", "all") {
+        if let Some(dx) = self.row("vm", "dop853+extrema", &default_setting, "all") {
             let _ = writeln!(
                 s,
                 "| (the same through `rebound`, with contact time, maximum overlap and force) | {:.2} us ({:.0} rhs evals) | - | {} | {} | - |",
@@ -814,7 +820,7 @@ impl BenchReport {
         );
         for (method, unit, scale) in [
             ("master table", "ns", 1.0),
-            ("dop853 tol=1e-12", "us", 1e3),
+            (default_method.as_str(), "us", 1e3),
             ("closed form", "ns", 1.0),
         ] {
             if let Some((lo, hi)) = self.point_range(method) {

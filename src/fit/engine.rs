@@ -363,10 +363,13 @@ fn global_minimum(obj: &Objective, options: &FitOptions) -> Result<LmOutcome> {
 fn scan_1d(obj: &Objective) -> Result<LmOutcome> {
     let spacing = if obj.kind == ModelKind::Vm { 0.5 } else { 0.1 };
     let g = grid(obj.lower[0], obj.upper[0], spacing);
-    let mut vals = Vec::with_capacity(g.len());
-    for &t in &g {
-        vals.push(lsq::chi2(obj, &[t])?);
-    }
+    // A grid point where the model cannot be evaluated (a coarse ODE setting refusing a large
+    // kappa far from the data's optimum) is rejected, not fatal; the polish still needs the
+    // model where the minimum is.
+    let vals: Vec<f64> = g
+        .iter()
+        .map(|&t| lsq::chi2(obj, &[t]).unwrap_or(f64::INFINITY))
+        .collect();
     let kbest = (0..g.len())
         .min_by(|&a, &b| vals[a].total_cmp(&vals[b]))
         .unwrap_or(0);
@@ -409,10 +412,15 @@ fn scan_2d(obj: &Objective) -> Result<Vec<Vec<f64>>> {
         obj.evals.set(obj.evals.get() + 1);
         Ok(c)
     };
+    // Rows where e_vm cannot be evaluated (see scan_1d) are marked and rejected below.
     let mut vm_rows = vec![0.0; ge.len() * n];
+    let mut row_ok = vec![true; ge.len()];
     for (a, &t) in ge.iter().enumerate() {
         for i in 0..n {
-            vm_rows[a * n + i] = ev.e_vm(i, t.exp())?;
+            match ev.e_vm(i, t.exp()) {
+                Ok(e) => vm_rows[a * n + i] = e,
+                Err(_) => row_ok[a] = false,
+            }
         }
     }
     let mut profile = Vec::with_capacity(gs.len());
@@ -423,7 +431,11 @@ fn scan_2d(obj: &Objective) -> Result<Vec<Vec<f64>>> {
         }
         let mut coarse = Vec::with_capacity(ge.len());
         for a in 0..ge.len() {
-            coarse.push(chi2_with(&|i| Ok(vm_rows[a * n + i]), &pm)?);
+            coarse.push(if row_ok[a] {
+                chi2_with(&|i| Ok(vm_rows[a * n + i]), &pm)?
+            } else {
+                f64::INFINITY
+            });
         }
         let abest = (0..ge.len())
             .min_by(|&x, &y| coarse[x].total_cmp(&coarse[y]))

@@ -123,12 +123,15 @@ pub struct OdeSettings {
 }
 
 impl OdeSettings {
-    /// The default: Dop853 at rtol = atol = 1e-12, which meets |error in e| <= 1e-10 and a relative
-    /// error of 1 - e below 1e-8 over kappa in [1e-8, 100] (tests/viscoelastic.rs).
+    /// The default: Dop853 at rtol = atol = 1e-11, the cheapest tolerance that meets
+    /// |error in e| <= 1e-10 and a relative error of 1 - e <= 1e-8 over kappa in [1e-8, 100], both
+    /// rules, with a wide margin (measured 2.8e-12 and 9.0e-12: `restitution bench`'s candidates;
+    /// 1e-10 also passes, with a margin of only 3.4; 1e-12 costs 23% more for accuracy nobody asked
+    /// for). Checked in tests/viscoelastic.rs against the mpmath values.
     pub const DEFAULT: OdeSettings = OdeSettings {
         integrator: Integrator::Dop853,
-        rtol: 1e-12,
-        atol: 1e-12,
+        rtol: 1e-11,
+        atol: 1e-11,
         max_steps: 200_000,
         stiffness_check: false,
     };
@@ -670,12 +673,25 @@ fn solve(kappa: f64, rule: ContactEnd, settings: &OdeSettings, extrema: bool) ->
     } else {
         x_end
     };
-    let j = match var {
-        Var::Root => y[2],
-        Var::Time => y[2],
-    };
+    let j = y[2];
     // Energy balance: p_end^2/2 + (2/5) x_end^(5/2) = 1/2 - kappa J.
     let one_minus_e2 = 2.0 * kappa * j + 0.8 * x_end.powf(2.5);
+    // A trajectory that dissipated more than the impact energy, or whose final speed disagrees
+    // grossly with the energy it kept, is not a solution (coarse fixed-step RK4 at kappa ~ 10
+    // returned e = 0.02-0.23 against 1e-6 this way; found by the bench's probe). Accurate runs
+    // agree to about the tolerance; 1e-6 and 1e-3 leave room for deliberately coarse settings.
+    let e2_energy = 1.0 - one_minus_e2;
+    if e2_energy < -1e-6 || (e2_energy > 0.25 && (e2_energy.sqrt() + p_end).abs() > 1e-3) {
+        return Err(Error::Integration {
+            method: settings.integrator.name(),
+            kappa,
+            reason: format!(
+                "unphysical result: energy balance violated (e from the energy {}, from the speed {})",
+                e2_energy.max(0.0).sqrt(),
+                -p_end
+            ),
+        });
+    }
     let e_energy = (1.0 - one_minus_e2).max(0.0).sqrt();
     let (e, one_minus_e) = if e_energy > 0.5 {
         (e_energy, one_minus_e2 / (1.0 + e_energy))
@@ -786,16 +802,15 @@ mod tests {
     #[test]
     fn hertz_limit_is_elastic() {
         // kappa = 0: e = 1 exactly, and the Hertz contact time and maximum overlap are known in
-        // closed form: x_max = (5/4)^(2/5), tau = 3.2180654597190430845 (PHYSICS.md §2).
+        // closed form: x_max = (5/4)^(2/5), tau = 3.2180654597190430845 (PHYSICS.md §2). The
+        // trajectory is accurate to about the tolerance, so these get 10 tol.
+        let tol = 10.0 * OdeSettings::DEFAULT.rtol;
         for rule in ContactEnd::ALL {
             let r = rebound(0.0, rule, &OdeSettings::DEFAULT).unwrap();
             assert!((r.e - 1.0).abs() < 1e-14, "{rule}: {r:?}");
-            assert!(
-                (r.tau_contact - 3.2180654597190430845).abs() < 1e-10,
-                "{r:?}"
-            );
-            assert!((r.x_max - 1.25f64.powf(0.4)).abs() < 1e-12, "{r:?}");
-            assert!((r.force_max - 1.25f64.powf(0.6)).abs() < 1e-11, "{r:?}");
+            assert!((r.tau_contact - 3.2180654597190430845).abs() < tol, "{r:?}");
+            assert!((r.x_max - 1.25f64.powf(0.4)).abs() < tol, "{r:?}");
+            assert!((r.force_max - 1.25f64.powf(0.6)).abs() < tol, "{r:?}");
         }
     }
 
