@@ -29,3 +29,6 @@ $B kinematics data/virtual/oblique/tracks.csv --material nylon --fixed-gravity \
 $B walton fit reports/kinematics/oblique/walton_input.csv --material nylon \
     --out reports/kinematics/oblique/walton > /dev/null
 $B simulate --material nylon --camera-study --incidence-deg 0,45 --out reports/kinematics > /dev/null
+
+# Bench (issue 4): work-precision chart, stability map, fit accuracy, targets (timings vary by machine).
+$B bench --out reports/bench > /dev/null

@@ -49,6 +49,11 @@ from mpmath import mp, mpf
 
 U_VALUES = ["0.5", "1", "1+1e-12", "1+1e-9", "1+1e-6", "1+1e-3", "1.01", "1.1", "1.5", "2", "3",
             "5", "10", "30", "100", "1e3", "1e4", "1e6", "1e9", "1e12"]
+# A dense grid as well, so that ulp bounds are checked between the round numbers: u - 1 from
+# 1e-12 to 1 in steps of 10^(1/4), then u from 10^(1/8) to 1e12 in steps of 10^(1/8) (the
+# printed double is the value used).
+U_VALUES += [repr(1.0 + 10.0 ** (-k / 4)) for k in range(1, 48)]
+U_VALUES += [repr(10.0 ** (k / 8)) for k in range(1, 97)]
 
 DPS_A = 50
 DPS_B = 90
