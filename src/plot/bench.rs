@@ -208,13 +208,7 @@ pub fn work_precision_svg(report: &BenchReport) -> Result<String, String> {
             )))
             .map_err(err_str)?;
         }
-        a.configure_series_labels()
-            .position(SeriesLabelPosition::LowerMiddle)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 17))
-            .draw()
-            .map_err(err_str)?;
+        super::legend(&mut a, SeriesLabelPosition::LowerMiddle, 17)?;
 
         // (b)
         let ode: Vec<&WpRow> = vm.iter().copied().filter(|r| r.rhs_evals > 0.0).collect();
@@ -228,13 +222,7 @@ pub fn work_precision_svg(report: &BenchReport) -> Result<String, String> {
             y_vm,
         )?;
         draw_lines(&mut b, &ode, |r| r.rhs_evals, |r| r.error, false, "")?;
-        b.configure_series_labels()
-            .position(SeriesLabelPosition::UpperMiddle)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 17))
-            .draw()
-            .map_err(err_str)?;
+        super::legend(&mut b, SeriesLabelPosition::UpperMiddle, 17)?;
 
         // (c)
         let pm: Vec<&WpRow> = report
@@ -269,13 +257,7 @@ pub fn work_precision_svg(report: &BenchReport) -> Result<String, String> {
             true,
             ": 1 - e",
         )?;
-        c.configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 17))
-            .draw()
-            .map_err(err_str)?;
+        super::legend(&mut c, SeriesLabelPosition::UpperRight, 17)?;
 
         // (d)
         let rk4: Vec<&WpRow> = report
@@ -351,13 +333,7 @@ pub fn work_precision_svg(report: &BenchReport) -> Result<String, String> {
                 .label("slope 4")
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], gstyle));
         }
-        d.configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 17))
-            .draw()
-            .map_err(err_str)?;
+        super::legend(&mut d, SeriesLabelPosition::LowerRight, 17)?;
         root.present().map_err(err_str)?;
     }
     Ok(svg)
@@ -722,14 +698,7 @@ pub fn fit_accuracy_svg(report: &BenchReport) -> Result<String, String> {
                     )))
                     .map_err(err_str)?;
             }
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::LowerRight)
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .label_font(("sans-serif", 17))
-                .draw()
-                .map_err(err_str)?;
+            super::legend(&mut chart, SeriesLabelPosition::LowerRight, 17)?;
         }
         root.present().map_err(err_str)?;
     }

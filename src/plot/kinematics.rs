@@ -137,14 +137,7 @@ pub fn camera_study_svg(points: &[StudyPoint], title: &str) -> Result<String, St
                     + PathElement::new([(11, 0), (18, 0)], BLACK.stroke_width(2))
                     + PathElement::new([(22, 0), (26, 0)], BLACK.stroke_width(2))
             });
-        scatter
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font(("sans-serif", 17))
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK.mix(0.5))
-            .draw()
-            .map_err(e)?;
+        super::legend(&mut scatter, SeriesLabelPosition::UpperRight, 17)?;
         root.present().map_err(e)?;
     }
     Ok(svg)

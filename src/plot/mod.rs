@@ -3,7 +3,10 @@
 //!
 //! plotters' SVG font sizes come out smaller than asked, so sizes here are chosen by looking at
 //! the rendered figures, not by the nominal point size.
-use plotters::style::RGBColor;
+use plotters::chart::{ChartContext, SeriesLabelPosition};
+use plotters::coord::CoordTranslate;
+use plotters::prelude::DrawingBackend;
+use plotters::style::{BLACK, Color, RGBColor, WHITE};
 
 /// Okabe & Ito's colour-blind-safe palette (without black and yellow, which carry the models and
 /// vanish on white), shared by every figure so that series look alike across them.
@@ -22,6 +25,23 @@ pub fn colour(i: usize) -> RGBColor {
 }
 
 pub mod bench;
+/// Draws a chart's legend in the house style: a nearly opaque white box with a grey border, at
+/// `position`, labels at `font_px` (nominal; see the module note on SVG font sizes).
+pub fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    font_px: u32,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font(("sans-serif", font_px))
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK.mix(0.5))
+        .draw()
+        .map_err(|e| format!("drawing a legend: {e}"))
+}
+
 pub mod fit;
 pub mod kinematics;
 pub mod walton;

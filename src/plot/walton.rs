@@ -164,14 +164,7 @@ pub fn fig6_svg(points: &[Fig6Point], fit: &Fig6Fit, title: &str) -> Result<Stri
             .map_err(e)?
             .label(label)
             .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(2)));
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .label_font(("sans-serif", 19))
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK.mix(0.5))
-            .draw()
-            .map_err(e)?;
+        super::legend(&mut chart, SeriesLabelPosition::LowerRight, 19)?;
         root.present().map_err(e)?;
     }
     Ok(svg)
