@@ -51,6 +51,42 @@ pub struct WpPoint {
     pub failure: Option<String>,
 }
 
+impl WpPoint {
+    /// A chart point from one evaluation, `(e, 1 - e, rhs evaluations)`, or its error value,
+    /// against the reference `(x, e_ref, 1 - e_ref)`.
+    fn new(
+        model: &'static str,
+        (method, setting): (String, String),
+        rule: &str,
+        (x, e_ref, ome_ref): (f64, f64, f64),
+        got: crate::Result<(f64, f64, f64)>,
+    ) -> Self {
+        let (e, abs_error, rel_error_one_minus_e, rhs_evals, failure) = match got {
+            Ok((e, ome, evals)) => (e, (e - e_ref).abs(), rel(ome, ome_ref), evals, None),
+            Err(err) => (
+                f64::NAN,
+                f64::NAN,
+                f64::NAN,
+                f64::NAN,
+                Some(err.to_string()),
+            ),
+        };
+        WpPoint {
+            model,
+            method,
+            setting,
+            rule: rule.into(),
+            x,
+            e,
+            e_ref,
+            abs_error,
+            rel_error_one_minus_e,
+            rhs_evals,
+            failure,
+        }
+    }
+}
+
 struct Acc {
     error: f64,
     rel_e: f64,
@@ -118,34 +154,14 @@ pub fn vm_rows(spec: &VmSpec, refs: &[VmRef], plan: &TimingPlan) -> (Vec<WpRow>,
         }
         let mut acc = Acc::new();
         for r in &set {
-            let p = match spec.eval(r.kappa, rule) {
-                Ok(got) => WpPoint {
-                    model: "vm",
-                    method: spec.method(),
-                    setting: spec.setting(),
-                    rule: rule.name().into(),
-                    x: r.kappa,
-                    e: got.e,
-                    e_ref: r.e,
-                    abs_error: (got.e - r.e).abs(),
-                    rel_error_one_minus_e: rel(got.one_minus_e, r.one_minus_e),
-                    rhs_evals: got.rhs_evals as f64,
-                    failure: None,
-                },
-                Err(err) => WpPoint {
-                    model: "vm",
-                    method: spec.method(),
-                    setting: spec.setting(),
-                    rule: rule.name().into(),
-                    x: r.kappa,
-                    e: f64::NAN,
-                    e_ref: r.e,
-                    abs_error: f64::NAN,
-                    rel_error_one_minus_e: f64::NAN,
-                    rhs_evals: f64::NAN,
-                    failure: Some(err.to_string()),
-                },
-            };
+            let got = spec.eval(r.kappa, rule);
+            let p = WpPoint::new(
+                "vm",
+                (spec.method(), spec.setting()),
+                rule.name(),
+                (r.kappa, r.e, r.one_minus_e),
+                got.map(|g| (g.e, g.one_minus_e, g.rhs_evals as f64)),
+            );
             acc.add(&p);
             all.add(&p);
             points.push(p);
@@ -220,34 +236,14 @@ pub fn pm_rows(spec: &PmSpec, refs: &[PmRef], plan: &TimingPlan) -> (WpRow, Vec<
     let mut acc = Acc::new();
     let mut points = Vec::new();
     for r in &set {
-        let p = match spec.eval(r.u) {
-            Ok(got) => WpPoint {
-                model: "pm",
-                method: spec.method(),
-                setting: spec.setting(),
-                rule: "-".into(),
-                x: r.u,
-                e: got.e,
-                e_ref: r.e,
-                abs_error: (got.e - r.e).abs(),
-                rel_error_one_minus_e: rel(got.one_minus_e, r.one_minus_e),
-                rhs_evals: got.evals as f64,
-                failure: None,
-            },
-            Err(err) => WpPoint {
-                model: "pm",
-                method: spec.method(),
-                setting: spec.setting(),
-                rule: "-".into(),
-                x: r.u,
-                e: f64::NAN,
-                e_ref: r.e,
-                abs_error: f64::NAN,
-                rel_error_one_minus_e: f64::NAN,
-                rhs_evals: f64::NAN,
-                failure: Some(err.to_string()),
-            },
-        };
+        let got = spec.eval(r.u);
+        let p = WpPoint::new(
+            "pm",
+            (spec.method(), spec.setting()),
+            "-",
+            (r.u, r.e, r.one_minus_e),
+            got.map(|g| (g.e, g.one_minus_e, g.evals as f64)),
+        );
         acc.add(&p);
         points.push(p);
     }
