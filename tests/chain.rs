@@ -45,51 +45,67 @@ fn covers(v: &serde_json::Value, truth: f64) -> bool {
     lo <= truth && truth <= hi
 }
 
+/// Films a virtual experiment (`simulate` with `scene` flags and `seed`) and measures it with
+/// fixed-gravity `kinematics`; returns the kinematics output directory.
+fn simulate_and_measure(tag: &str, seed: u32, scene: &[&str]) -> PathBuf {
+    let sim = tmp(&format!("{tag}{seed}"));
+    let kin = tmp(&format!("{tag}k{seed}"));
+    let seed = seed.to_string();
+    let mut args = vec![
+        "simulate",
+        "--material",
+        "nylon",
+        "--out",
+        s(&sim),
+        "--seed",
+        &seed,
+    ];
+    args.extend_from_slice(scene);
+    run(&args);
+    let tracks = sim.join("tracks.csv");
+    run(&[
+        "kinematics",
+        s(&tracks),
+        "--material",
+        "nylon",
+        "--fixed-gravity",
+        "--out",
+        s(&kin),
+        "--format",
+        "csv",
+    ]);
+    kin
+}
+
 #[test]
 fn planted_eta_and_sigma_y_come_back() {
     let (eta, sigma_y) = (190.0, 4.0e7);
     let (mut eta_in, mut sy_in) = (0, 0);
     for seed in 1..=8 {
-        let sim = tmp(&format!("n{seed}"));
-        let kin = tmp(&format!("nk{seed}"));
-        let seed = seed.to_string();
-        run(&[
-            "simulate",
-            "--material",
-            "nylon",
-            "--out",
-            s(&sim),
-            "--n",
-            "150",
-            "--seed",
-            &seed,
-            "--d-mm",
-            "12.7",
-            "--v-n-m-s",
-            "0.5,25",
-            "--incidence-deg",
-            "0,30",
-            "--model",
-            "product",
-            "--eta",
-            "190",
-            "--sigma-y-pa",
-            "4e7",
-        ]);
-        run(&[
-            "kinematics",
-            s(&sim.join("tracks.csv")),
-            "--material",
-            "nylon",
-            "--fixed-gravity",
-            "--out",
-            s(&kin),
-            "--format",
-            "csv",
-        ]);
+        let kin = simulate_and_measure(
+            "n",
+            seed,
+            &[
+                "--n",
+                "150",
+                "--d-mm",
+                "12.7",
+                "--v-n-m-s",
+                "0.5,25",
+                "--incidence-deg",
+                "0,30",
+                "--model",
+                "product",
+                "--eta",
+                "190",
+                "--sigma-y-pa",
+                "4e7",
+            ],
+        );
+        let input = kin.join("fit_input.csv");
         let out = run(&[
             "fit",
-            s(&kin.join("fit_input.csv")),
+            s(&input),
             "--material",
             "nylon",
             "--model",
@@ -114,45 +130,29 @@ fn planted_eta_and_sigma_y_come_back() {
 fn planted_beta0_and_mu0_come_back() {
     let (mut b_in, mut m_in) = (0, 0);
     for seed in 1..=8 {
-        let sim = tmp(&format!("o{seed}"));
-        let kin = tmp(&format!("ok{seed}"));
-        let seed = seed.to_string();
-        run(&[
-            "simulate",
-            "--material",
-            "nylon",
-            "--out",
-            s(&sim),
-            "--n",
-            "120",
-            "--seed",
-            &seed,
-            "--v-n-m-s",
-            "1.5,2.5",
-            "--incidence-deg",
-            "5,80",
-            "--model",
-            "vm",
-            "--mu0",
-            "0.175",
-            "--beta0",
-            "0.5",
-        ]);
-        run(&[
-            "kinematics",
-            s(&sim.join("tracks.csv")),
-            "--material",
-            "nylon",
-            "--fixed-gravity",
-            "--out",
-            s(&kin),
-            "--format",
-            "csv",
-        ]);
+        let kin = simulate_and_measure(
+            "o",
+            seed,
+            &[
+                "--n",
+                "120",
+                "--v-n-m-s",
+                "1.5,2.5",
+                "--incidence-deg",
+                "5,80",
+                "--model",
+                "vm",
+                "--mu0",
+                "0.175",
+                "--beta0",
+                "0.5",
+            ],
+        );
+        let input = kin.join("walton_input.csv");
         let out = run(&[
             "walton",
             "fit",
-            s(&kin.join("walton_input.csv")),
+            s(&input),
             "--material",
             "nylon",
             "--format",
