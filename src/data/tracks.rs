@@ -104,25 +104,18 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
             }
         };
         let acc = &mut accs[i];
-        if d1 != acc.track.d1_m {
-            return Err(table.cell_error(
-                row,
-                d1_col,
-                format!(
-                    "'{}' differs from the collision's first row (line {})",
-                    row.fields[d1_col], acc.track.first_line
-                ),
-            ));
-        }
-        if d2 != acc.track.d2_m {
-            return Err(table.cell_error(
-                row,
-                d2_col,
-                format!(
-                    "'{}' differs from the collision's first row (line {})",
-                    row.fields[d2_col], acc.track.first_line
-                ),
-            ));
+        // A collision is one pair of spheres: its diameters cannot change between frames.
+        for (col, got, first) in [(d1_col, d1, acc.track.d1_m), (d2_col, d2, acc.track.d2_m)] {
+            if got != first {
+                return Err(table.cell_error(
+                    row,
+                    col,
+                    format!(
+                        "'{}' differs from the collision's first row (line {})",
+                        row.fields[col], acc.track.first_line
+                    ),
+                ));
+            }
         }
         if have_spins && acc.track.spins_rad_s.is_none() {
             acc.track.spins_rad_s = Some(spins.map(|w| if w.is_nan() { 0.0 } else { w }));
