@@ -8,7 +8,7 @@ use restitution::bench::quadrature::WorkQuadrature;
 use restitution::bench::reference::{pm_fixture, vm_fixture};
 use restitution::bench::stability::{self, Outcome, Role};
 use restitution::bench::{self, PmSpec, VmSpec};
-use restitution::error::{Error, IntegrationFailure};
+use restitution::error::Error;
 use restitution::models::viscoelastic::series::{self, Approximation, Pade, Series};
 use restitution::models::viscoelastic::{ContactEnd, Integrator, OdeSettings};
 
@@ -222,12 +222,10 @@ fn plastic_methods_hold_their_accuracy() {
 fn kind(r: restitution::Result<restitution::models::viscoelastic::Restitution>) -> String {
     match r {
         Ok(x) => format!("ok e={}", x.e),
-        Err(e @ Error::Integration { .. }) => e
-            .integration_failure()
-            .unwrap_or(IntegrationFailure::Other)
-            .name()
-            .into(),
+        Err(Error::Integration { kind, .. }) => kind.name().into(),
         Err(Error::InvalidParameter { .. }) => "invalid".into(),
+        Err(Error::BeyondErrorBound { .. }) => "refused".into(),
+        Err(e @ (Error::OutOfRange { .. } | Error::NoConvergence { .. })) => format!("other: {e}"),
     }
 }
 

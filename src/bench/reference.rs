@@ -156,7 +156,7 @@ mod tests {
         let vm = vm_fixture();
         assert_eq!(vm.len(), 46);
         assert!(vm.iter().all(|r| (r.e + r.one_minus_e - 1.0).abs() < 1e-15));
-        assert_eq!(pm_fixture().len(), 163);
+        assert_eq!(pm_fixture().len(), 180);
         // 5.1583817042676852164 (tools/reference/README.md).
         assert_eq!(overlap_large_kappa_a(), 5.158_381_704_267_685);
         assert!(series_constant("no such name").is_none());

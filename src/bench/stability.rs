@@ -52,7 +52,7 @@ impl Outcome {
     }
 
     /// Every outcome, in the order of the figure's legend.
-    pub const ALL: [Outcome; 11] = [
+    pub const ALL: [Outcome; 13] = [
         Outcome::Ok,
         Outcome::Inaccurate,
         Outcome::NotFinite,
@@ -63,6 +63,8 @@ impl Outcome {
         Outcome::Failed(IntegrationFailure::NonFinite),
         Outcome::Failed(IntegrationFailure::Unphysical),
         Outcome::Failed(IntegrationFailure::PhaseIncomplete),
+        Outcome::Failed(IntegrationFailure::EventLocation),
+        Outcome::Failed(IntegrationFailure::OutOfRange),
         Outcome::OtherError,
     ];
 }
@@ -103,13 +105,8 @@ pub struct Cell {
 
 fn classify_error(err: &Error) -> Outcome {
     match err {
-        Error::Integration { .. } => Outcome::Failed(
-            err.integration_failure()
-                .unwrap_or(IntegrationFailure::Other),
-        ),
-        Error::InvalidParameter { expected, .. } if expected.contains("error bound") => {
-            Outcome::Refused
-        }
+        Error::Integration { kind, .. } => Outcome::Failed(*kind),
+        Error::BeyondErrorBound { .. } => Outcome::Refused,
         _ => Outcome::OtherError,
     }
 }

@@ -352,6 +352,8 @@ fn outcome_color(o: Outcome) -> RGBColor {
         Outcome::Failed(F::NonFinite) => RGBColor(250, 150, 0),
         Outcome::Failed(F::Unphysical) => RGBColor(240, 210, 0),
         Outcome::Failed(F::PhaseIncomplete) => RGBColor(140, 90, 40),
+        Outcome::Failed(F::EventLocation) => RGBColor(230, 120, 180),
+        Outcome::Failed(F::OutOfRange) => RGBColor(150, 190, 240),
         Outcome::Failed(F::Other) | Outcome::OtherError => RGBColor(90, 90, 90),
     }
 }
@@ -371,6 +373,8 @@ fn outcome_label(o: Outcome) -> &'static str {
             "unphysical end: e outside (0, 1] or not separating (error value)"
         }
         Outcome::Failed(F::PhaseIncomplete) => "phase did not end (error value)",
+        Outcome::Failed(F::EventLocation) => "event not located (error value)",
+        Outcome::Failed(F::OutOfRange) => "beyond the checked kappa range (error value)",
         Outcome::Failed(F::Other) | Outcome::OtherError => "other error value",
     }
 }
