@@ -58,7 +58,11 @@ fn force_large() {
     )
     .unwrap();
     writeln!(out, "// Coefficients of h(y) = e kappa^(5/3), y = ln kappa, force rule, on piece i: y in [Y_MIN + i w, Y_MIN + (i + 1) w].").unwrap();
-    writeln!(out, "#![allow(clippy::unreadable_literal)]").unwrap();
+    writeln!(
+        out,
+        "#![allow(clippy::unreadable_literal, clippy::approx_constant)]"
+    )
+    .unwrap();
     writeln!(out, "pub const KAPPA_MIN: f64 = {k_min:?};").unwrap();
     writeln!(out, "pub const KAPPA_MAX: f64 = {k_max:?};").unwrap();
     writeln!(out, "pub const Y_MIN: f64 = {y0:?};").unwrap();

@@ -409,7 +409,7 @@ fn large_kappa_laws_agree_with_the_ode_where_both_hold() {
     };
     for (rule, kappa, bar) in [
         (ContactEnd::Overlap, 30.0, 1e-13),
-        (ContactEnd::Overlap, 300.0, 1e-13),
+        (ContactEnd::Overlap, 1000.0, 1e-13),
         (ContactEnd::Force, 300.0, 1e-11),
         (ContactEnd::Force, 1e5, 1e-8),
     ] {

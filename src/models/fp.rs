@@ -17,6 +17,8 @@ pub struct Dd {
     pub lo: f64,
 }
 
+// Named methods rather than operator traits: every dd operation stays visible at the call site.
+#[allow(clippy::should_implement_trait)]
 impl Dd {
     pub const fn new(hi: f64, lo: f64) -> Self {
         Dd { hi, lo }

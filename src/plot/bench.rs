@@ -234,7 +234,7 @@ pub fn work_precision_svg(report: &BenchReport) -> Result<String, String> {
         let y_c = (ERROR_FLOOR / 3.0, REL_ERROR_CAP * 1e4);
         let mut c = log_panel(
             &panels[2],
-            "(c) plastic: error vs time (u in (1, 1e12]; above 10 drawn at 10)",
+            "(c) plastic: error vs time (u in (1, f64::MAX]; above 10 drawn at 10)",
             "time per evaluation (ns)",
             "max relative error",
             x_c,
@@ -361,7 +361,7 @@ fn outcome_color(o: Outcome) -> RGBColor {
 fn outcome_label(o: Outcome) -> &'static str {
     use crate::error::IntegrationFailure as F;
     match o {
-        Outcome::Ok => "ok (error <= 1e-6)",
+        Outcome::Ok => "ok (relative error <= 1e-6)",
         Outcome::Inaccurate => "WRONG NUMBER: error > 1e-6 (loose rows: 100 tol), no error value",
         Outcome::NotFinite => "WRONG NUMBER: NaN, no error value",
         Outcome::Refused => "refused: error bound above 1e-6 (error value)",
@@ -535,7 +535,7 @@ pub fn stability_svg(report: &BenchReport) -> Result<String, String> {
         let (title, rest) = root.split_vertically(50);
         title
             .titled(
-                "Stability map: where each method fails, and how (threshold: error <= 1e-6 in e and relative in 1 - e)",
+                "Stability map: where each method fails, and how (threshold: relative error <= 1e-6 in e and in 1 - e)",
                 ("sans-serif", 22),
             )
             .map_err(err_str)?;
@@ -547,7 +547,10 @@ pub fn stability_svg(report: &BenchReport) -> Result<String, String> {
             "kappa (dimensionless damping)",
             &vm,
             |c| c.x,
-            Some((100.0, "end of the master table: kappa = 100")),
+            Some((
+                10.0,
+                "master curve: table below kappa = 10, large-kappa laws above",
+            )),
         )?;
         map_panel(
             &mid,

@@ -32,6 +32,7 @@ pub mod ode;
 pub mod series;
 pub mod settings;
 pub mod si;
+mod stepper;
 
 pub use ode::{rebound, restitution_ode};
 pub use settings::{

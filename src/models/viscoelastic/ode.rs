@@ -21,12 +21,12 @@
 //! keeps the relative accuracy of a tiny e at large kappa).
 
 use super::events::{Bracket, EVENTS, Event, event_value, force, locate};
-use super::settings::{Integrator, OdeSettings, Rebound, check_ode_range};
+use super::settings::{OdeSettings, Rebound, check_ode_range};
+pub(super) use super::stepper::integrate;
 use super::{ContactEnd, Restitution};
 use crate::error::{Error, IntegrationFailure, Num, Result, non_negative};
 use nalgebra::Vector4;
-use ode_solvers::dop_shared::IntegrationError;
-use ode_solvers::{Dop853, Dopri5, OutputType, System};
+use ode_solvers::System;
 
 // The fourth component carries the independent variable, so that the system is autonomous:
 // ode_solvers 0.6's Dop853 tableau has c_12 = 0 where DOP853 needs c_12 = 1, which silently
@@ -59,7 +59,7 @@ pub(super) enum Var {
 }
 
 impl Stage {
-    fn var(self) -> Var {
+    pub(super) fn var(self) -> Var {
         match self {
             Stage::Loading | Stage::Unloading => Var::Root,
             Stage::Turning => Var::Time,
@@ -86,15 +86,15 @@ fn time_of(var: Var, s: f64, y: &State) -> f64 {
 /// One phase of the integration, seen by the solver through `&mut Phase` so that the caller can
 /// read back what `solout` recorded.
 pub(super) struct Phase {
-    kappa: f64,
-    stage: Stage,
-    rule: ContactEnd,
+    pub(super) kappa: f64,
+    pub(super) stage: Stage,
+    pub(super) rule: ContactEnd,
     /// Turning stage stops once p < 0 and x <= this.
-    x_switch: f64,
-    prev: (f64, State),
-    brackets: [Option<Bracket>; 3],
-    stopped: bool,
-    steps: u64,
+    pub(super) x_switch: f64,
+    pub(super) prev: (f64, State),
+    pub(super) brackets: [Option<Bracket>; 3],
+    pub(super) stopped: bool,
+    pub(super) steps: u64,
 }
 
 impl Phase {
@@ -112,7 +112,7 @@ impl Phase {
     }
 
     /// Called at every accepted step; returns true to stop the phase.
-    fn accept(&mut self, s: f64, y: State) -> bool {
+    pub(super) fn accept(&mut self, s: f64, y: State) -> bool {
         self.steps += 1;
         if let Stage::Probe(_) = self.stage {
             return false;
@@ -183,136 +183,6 @@ impl System<f64, State> for &mut Phase {
     fn solout(&mut self, s: f64, y: &State, _dy: &State) -> bool {
         self.accept(s, *y)
     }
-}
-
-fn integration_error(settings: &OdeSettings, kappa: f64, e: IntegrationError) -> Error {
-    Error::Integration {
-        method: settings.integrator.name(),
-        kappa,
-        kind: IntegrationFailure::from(&e),
-        reason: e.to_string(),
-    }
-}
-
-/// Integrates `phase` from (s0, y0) towards s1 until its `accept` stops it or s1 is reached.
-/// Returns the last accepted point and the right-hand-side evaluations spent.
-pub(super) fn integrate(
-    phase: &mut Phase,
-    s0: f64,
-    y0: State,
-    s1: f64,
-    settings: &OdeSettings,
-) -> Result<(f64, State, u64)> {
-    let kappa = phase.kappa;
-    let n_stiff = if settings.stiffness_check {
-        1000
-    } else {
-        u32::MAX
-    };
-    let h_max = (s1 - s0).abs();
-    // Every phase variable is O(1) over a contact, so a first step of 0.05 (or the whole span of a
-    // short refinement) is safe; the solver's own first guess starts near 1e-6 at r = 0, where the
-    // right side vanishes, and wastes steps growing from there.
-    let h0 = (s1 - s0).signum() * h_max.min(0.05);
-    macro_rules! adaptive {
-        ($solver:ident, $beta:expr) => {{
-            let mut solver = $solver::from_param(
-                &mut *phase,
-                s0,
-                s1,
-                0.0,
-                y0,
-                settings.rtol,
-                settings.atol,
-                0.9,
-                $beta,
-                0.333,
-                6.0,
-                h_max,
-                h0,
-                settings.max_steps,
-                n_stiff,
-                OutputType::Sparse,
-            );
-            let stats = solver
-                .integrate()
-                .map_err(|e| integration_error(settings, kappa, e))?;
-            let s = *solver
-                .x_out()
-                .last()
-                .expect("solver output holds the start");
-            let y = *solver
-                .y_out()
-                .last()
-                .expect("solver output holds the start");
-            Ok((s, y, stats.num_eval as u64))
-        }};
-    }
-    match settings.integrator {
-        // Hairer's recommended PI-controller betas: 0 for DOP853, 0.04 for DOPRI5.
-        Integrator::Dop853 => adaptive!(Dop853, 0.0),
-        Integrator::Dopri5 => adaptive!(Dopri5, 0.04),
-        Integrator::Rk4 { h } => rk4(phase, s0, y0, s1, h, settings),
-    }
-}
-
-/// Classical RK4 at fixed step: ceil(|s1 - s0|/h) equal steps that land exactly on s1.
-fn rk4(
-    phase: &mut Phase,
-    s0: f64,
-    y0: State,
-    s1: f64,
-    h: f64,
-    settings: &OdeSettings,
-) -> Result<(f64, State, u64)> {
-    let kappa = phase.kappa;
-    let var = phase.stage.var();
-    let span = s1 - s0;
-    let n = (span.abs() / h).ceil().max(1.0);
-    let hh = span / n;
-    let (mut s, mut y) = (s0, y0);
-    let (mut k1, mut k2, mut k3, mut k4) = (
-        State::zeros(),
-        State::zeros(),
-        State::zeros(),
-        State::zeros(),
-    );
-    let mut evals = 0u64;
-    let mut i = 0.0;
-    while i < n {
-        if phase.steps >= settings.max_steps as u64 {
-            return Err(Error::Integration {
-                method: "rk4",
-                kappa,
-                kind: IntegrationFailure::MaxSteps,
-                reason: format!(
-                    "stopped at {}: needs more than {} steps",
-                    Num(s),
-                    settings.max_steps
-                ),
-            });
-        }
-        rhs(kappa, var, &y, &mut k1);
-        rhs(kappa, var, &(y + k1 * (0.5 * hh)), &mut k2);
-        rhs(kappa, var, &(y + k2 * (0.5 * hh)), &mut k3);
-        rhs(kappa, var, &(y + k3 * hh), &mut k4);
-        evals += 4;
-        y += (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (hh / 6.0);
-        i += 1.0;
-        s = if i < n { s0 + i * hh } else { s1 };
-        if !y.iter().all(|v| v.is_finite()) {
-            return Err(Error::Integration {
-                method: "rk4",
-                kappa,
-                kind: IntegrationFailure::NonFinite,
-                reason: format!("non-finite state at {}: step {} too large", Num(s), Num(h)),
-            });
-        }
-        if phase.accept(s, y) {
-            break;
-        }
-    }
-    Ok((s, y, evals))
 }
 
 /// e and the other collision figures for dimensionless damping `kappa` (PHYSICS.md §2).
