@@ -9,7 +9,7 @@
 //!
 //! **Against what.** The mpmath fixtures (25 and 30 digits, tools/reference/), compiled in: the
 //! chart's viscoelastic points are the fixture's kappa in [1e-4, 5] for both rules (16 each), the
-//! plastic points the fixture's u in (1, 1e12] (18). The stability map's dense kappa grid uses
+//! plastic points the fixture's u in (1, f64::MAX]. The stability map's dense kappa grid uses
 //! [`reference::vm_dense_reference`] (the ODE at 1e-15, checked against the fixture in the report).
 //!
 //! **Time** is wall-clock per evaluation, warm, the minimum over repeated batches

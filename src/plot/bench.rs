@@ -410,9 +410,37 @@ fn row_key(c: &Cell) -> String {
     format!("{}{setting}{rule}{role}", c.method)
 }
 
-/// Cell edges in log10(x): midpoints between neighbouring grid values.
+/// The map's x coordinate: log10(x), compressed eightfold above 1e4, so that the dense grid up to
+/// 1e4 stays readable next to the sparse one reaching f64::MAX.
+fn squash(x: f64) -> f64 {
+    let l = x.log10();
+    if l <= SQUASH_FROM {
+        l
+    } else {
+        SQUASH_FROM + (l - SQUASH_FROM) / SQUASH
+    }
+}
+
+const SQUASH_FROM: f64 = 4.0;
+const SQUASH: f64 = 8.0;
+
+/// The decade shown at map coordinate c (inverse of [`squash`]), when it is a whole one.
+fn unsquash_label(c: f64) -> String {
+    let l = if c <= SQUASH_FROM {
+        c
+    } else {
+        SQUASH_FROM + (c - SQUASH_FROM) * SQUASH
+    };
+    if (l - l.round()).abs() < 1e-6 {
+        format!("1e{}", l.round() as i32)
+    } else {
+        String::new()
+    }
+}
+
+/// Cell edges in map coordinates: midpoints between neighbouring grid values.
 fn edges(xs: &[f64]) -> Vec<f64> {
-    let l: Vec<f64> = xs.iter().map(|x| x.log10()).collect();
+    let l: Vec<f64> = xs.iter().map(|&x| squash(x)).collect();
     let mut e = Vec::with_capacity(l.len() + 1);
     for i in 0..=l.len() {
         let v = if i == 0 {
@@ -457,13 +485,7 @@ fn map_panel(
         .axis_desc_style(("sans-serif", 20))
         .label_style(("sans-serif", 16))
         .x_labels(14)
-        .x_label_formatter(&|v| {
-            if (v - v.round()).abs() < 1e-9 {
-                format!("1e{}", v.round() as i32)
-            } else {
-                String::new()
-            }
-        })
+        .x_label_formatter(&|v| unsquash_label(*v))
         .y_labels(rows.len())
         .y_label_formatter(&|v| {
             let i = v.round();
@@ -487,7 +509,7 @@ fn map_panel(
         }))
         .map_err(err_str)?;
     if let Some((x, text)) = mark {
-        let lx = x.log10();
+        let lx = squash(x);
         chart
             .draw_series(DashedLineSeries::new(
                 vec![(lx, -0.5), (lx, n - 0.5)],
@@ -544,7 +566,7 @@ pub fn stability_svg(report: &BenchReport) -> Result<String, String> {
         map_panel(
             &top,
             "viscoelastic model: dimensionless damping kappa",
-            "kappa (dimensionless damping)",
+            "kappa (dimensionless damping; log scale, compressed 8 times above 1e4)",
             &vm,
             |c| c.x,
             Some((
@@ -555,7 +577,7 @@ pub fn stability_svg(report: &BenchReport) -> Result<String, String> {
         map_panel(
             &mid,
             "plastic model: u = V/V_Y at the mpmath fixture's points (comparators are kept to show their failure)",
-            "u - 1",
+            "u - 1 (log scale, compressed 8 times above 1e4)",
             &pm,
             |c| c.x - 1.0,
             None,
