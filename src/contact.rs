@@ -4,8 +4,13 @@
 //! the effective radius R~, the reduced mass m_red and the Hertz stiffness K = (4/3) E* R~^(1/2).
 //! Identical spheres, unequal spheres and a sphere on a flat wall differ only in how these are
 //! formed, so every model works for all three.
+//!
+//! **Range.** Every derived quantity (E*, R~, m_red, K, kappa, V_Y) is either a normal, finite,
+//! positive f64 or an [`Error::OutOfRange`] naming the inputs it came from: the `try_` methods
+//! check; the plain ones (kept for callers that validated their inputs) do not.
 
-use crate::error::{Error, Result, positive};
+use crate::error::{Error, Num, Result, in_range, positive};
+use crate::models::fp;
 use std::f64::consts::PI;
 
 /// An isotropic elastic material.
@@ -151,7 +156,42 @@ impl Pair {
         }
     }
 
-    /// The derived contact quantities of this pair.
+    /// The derived contact quantities of this pair, each checked to be a normal, finite, positive
+    /// f64 (a 1e-110 m sphere has mass 0 in f64; a subnormal modulus makes E* infinite).
+    pub fn try_contact(&self) -> Result<Contact> {
+        let c = self.contact();
+        let describe = || self.describe();
+        in_range("E* (Pa)", c.e_star_pa, describe)?;
+        in_range("R~ (m)", c.r_eff_m, describe)?;
+        in_range("m_red (kg)", c.m_red_kg, describe)?;
+        in_range("K = (4/3) E* R~^(1/2) (N/m^1.5)", c.hertz_k(), describe)?;
+        Ok(c)
+    }
+
+    /// The inputs, for error messages.
+    fn describe(&self) -> String {
+        let m = |m: &Material| {
+            format!(
+                "Y = {} Pa, nu = {}, rho = {} kg/m^3",
+                Num(m.youngs_pa),
+                Num(m.poisson),
+                Num(m.density_kg_m3)
+            )
+        };
+        let s1 = &self.sphere;
+        let first = format!("d = {} m, {}", Num(s1.d_m), m(&s1.material));
+        match &self.partner {
+            Partner::Sphere(s2) if s2 == s1 => format!("identical spheres of {first}"),
+            Partner::Sphere(s2) => format!(
+                "spheres of {first} and d2 = {} m, {}",
+                Num(s2.d_m),
+                m(&s2.material)
+            ),
+            Partner::Wall(w) => format!("a sphere of {first} on a wall of {}", m(w)),
+        }
+    }
+
+    /// The derived contact quantities of this pair, unchecked (see [`Pair::try_contact`]).
     pub fn contact(&self) -> Contact {
         let s1 = &self.sphere;
         let (inv_r2, compliance2, inv_m2) = match &self.partner {
@@ -185,6 +225,37 @@ pub struct Contact {
 }
 
 impl Contact {
+    /// A contact from its three numbers, each checked to be a normal, finite, positive f64.
+    pub fn new(e_star_pa: f64, r_eff_m: f64, m_red_kg: f64) -> Result<Contact> {
+        positive("E* (Pa)", e_star_pa)?;
+        positive("R~ (m)", r_eff_m)?;
+        positive("m_red (kg)", m_red_kg)?;
+        let c = Contact {
+            e_star_pa,
+            r_eff_m,
+            m_red_kg,
+        };
+        let describe = || c.describe();
+        for (name, v) in [
+            ("E* (Pa)", e_star_pa),
+            ("R~ (m)", r_eff_m),
+            ("m_red (kg)", m_red_kg),
+            ("K = (4/3) E* R~^(1/2) (N/m^1.5)", c.hertz_k()),
+        ] {
+            in_range(name, v, describe)?;
+        }
+        Ok(c)
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "E* = {} Pa, R~ = {} m, m_red = {} kg",
+            Num(self.e_star_pa),
+            Num(self.r_eff_m),
+            Num(self.m_red_kg)
+        )
+    }
+
     /// Hertz stiffness K in P_el = K delta^(3/2): K = (4/3) E* R~^(1/2) (Eq. B1 for identical spheres,
     /// where it equals E d^(1/2) with the paper's E).
     pub fn hertz_k(&self) -> f64 {
@@ -226,6 +297,36 @@ impl Contact {
         c * k.powf(-0.6) * v_m_s.powf(0.2)
     }
 
+    /// [`Contact::kappa`], checked: eta >= 0 and v > 0 finite, and kappa a finite f64 that is 0
+    /// (eta = 0) or normal; otherwise an error naming eta, v and the contact.
+    pub fn try_kappa(&self, eta: f64, v_m_s: f64) -> Result<f64> {
+        crate::error::non_negative("damping eta (kg/(s m))", eta)?;
+        positive("impact speed (m/s)", v_m_s)?;
+        // kappa is linear in eta: check the per-unit-eta factor, then the product.
+        let per_eta = self.kappa(1.0, v_m_s);
+        let cause = || {
+            format!(
+                "eta = {} kg/(s m), v = {} m/s, {}",
+                Num(eta),
+                Num(v_m_s),
+                self.describe()
+            )
+        };
+        in_range("kappa per unit eta (s m/kg)", per_eta, cause)?;
+        if eta == 0.0 {
+            return Ok(0.0);
+        }
+        in_range("kappa", eta * per_eta, cause)
+    }
+
+    /// [`Contact::time_scale_s`], checked.
+    pub fn try_time_scale_s(&self, v_m_s: f64) -> Result<f64> {
+        positive("impact speed (m/s)", v_m_s)?;
+        in_range("time scale T (s)", self.time_scale_s(v_m_s), || {
+            format!("v = {} m/s, {}", Num(v_m_s), self.describe())
+        })
+    }
+
     /// The eta that gives dimensionless damping `kappa` at impact speed `v_m_s` (inverse of [`Contact::kappa`]).
     pub fn eta_for_kappa(&self, kappa: f64, v_m_s: f64) -> f64 {
         kappa / self.kappa(1.0, v_m_s)
@@ -243,9 +344,36 @@ impl Contact {
     }
 
     /// Impact speed at which yield starts, from W_y = (1/2) m_red V_Y^2; equals Eq. (15) for
-    /// identical spheres.
+    /// identical spheres. Unchecked: see [`Contact::try_yield_velocity_m_s`].
     pub fn yield_velocity_m_s(&self, sigma_y_pa: f64) -> f64 {
         (2.0 * self.yield_work_j(sigma_y_pa) / self.m_red_kg).sqrt()
+    }
+
+    /// V_Y, checked: sigma_y > 0 finite, and V_Y a normal, finite f64, else an error naming
+    /// sigma_y and the contact (sigma_y = 1e-130 Pa gives V_Y ~ 1e-345 m/s: underflow, not 0).
+    ///
+    /// V_Y ~ sigma_y^(5/2) exactly, so V_Y(sigma_y) = V_Y(4^j sigma_y) 2^(-5j): with j chosen so
+    /// that pi 4^j sigma_y/(2 E*) is near 1, no intermediate (delta_y, delta_y^(5/2), W_y)
+    /// under- or overflows unless V_Y itself does, and the power of two is applied once, exactly
+    /// or with the one rounding of a subnormal result.
+    pub fn try_yield_velocity_m_s(&self, sigma_y_pa: f64) -> Result<f64> {
+        positive("yield stress sigma_y (Pa)", sigma_y_pa)?;
+        let cause = || format!("sigma_y = {} Pa, {}", Num(sigma_y_pa), self.describe());
+        let ratio = PI * sigma_y_pa / (2.0 * self.e_star_pa);
+        let j = if ratio.is_finite() && ratio > 0.0 {
+            (-0.5 * ratio.log2()).round() as i32
+        } else {
+            0
+        };
+        // 4^j sigma_y: exact (a power of two), and normal: the ratio is then near 1.
+        let scaled_sigma = fp::scale2(sigma_y_pa, 2 * j);
+        let v_scaled = self.yield_velocity_m_s(scaled_sigma);
+        let v = if v_scaled.is_finite() && v_scaled >= f64::MIN_POSITIVE {
+            fp::scale2(v_scaled, -5 * j)
+        } else {
+            v_scaled
+        };
+        in_range("V_Y (m/s)", v, cause)
     }
 
     /// The sigma_y that makes V_Y equal `v_yield_m_s` (V_Y grows like sigma_y^(5/2)).

@@ -26,7 +26,7 @@
 //! **Needs**: at least 3 frames per phase (free fits) or 2 (fixed gravity), distinct times.
 
 use crate::contact::{Material, Sphere};
-use crate::error::{Error, Result};
+use crate::error::{Error, Num, Result};
 use crate::models::walton::{self, Body, Measured, State};
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 
@@ -290,7 +290,7 @@ pub fn analyse(
     };
     let window = (pre.t_last_s - dt, post.t_first_s + dt);
     let contact = 0.5 * (d1_m + d2_m);
-    let (t_c, rule) = collision_time(&pre, &post, contact, window, None);
+    let (t_c, rule) = collision_time(&pre, &post, contact, window, None)?;
     let all = pre.fits.iter().chain(post.fits.iter());
     let (rss, dof) = all.fold((0.0, 0usize), |(r, d), f| (r + f.rss, d + f.n - need));
     let v = [
@@ -330,7 +330,7 @@ fn collision_time(
     contact_m: f64,
     window: (f64, f64),
     rule: Option<TimeRule>,
-) -> (f64, TimeRule) {
+) -> Result<(f64, TimeRule)> {
     let (lo, hi) = window;
     let gap = |t: f64| (pre.position(0, t) - pre.position(1, t)).norm() - contact_m;
     let mismatch = |t: f64| {
@@ -340,12 +340,12 @@ fn collision_time(
     };
     let crossing = match rule {
         Some(TimeRule::FitsMeet) => None,
-        _ => first_crossing(&gap, lo, hi),
+        _ => first_crossing(&gap, lo, hi)?,
     };
-    match crossing {
+    Ok(match crossing {
         Some(t) => (t, TimeRule::ContactDistance),
-        None => (argmin_scan(&mismatch, lo, hi), TimeRule::FitsMeet),
-    }
+        None => (argmin_scan(&mismatch, lo, hi)?, TimeRule::FitsMeet),
+    })
 }
 
 /// (e, v_n) of the fits: the normal from the pre-collision centres at t_c, e = -(v1' - v2').n /
@@ -361,10 +361,10 @@ fn normal_restitution(pre: &PhaseFit, post: &PhaseFit, t_c: f64) -> (f64, f64) {
 /// Standard errors of (e, v_n) by linear propagation of every fit parameter's covariance
 /// (sigma^2 (X^T X)^-1 per fit; fits independent) through the whole chain, collision time and
 /// normal included, with central differences of step 1e-4 standard deviations.
-fn propagate(k: &Kinematics, sigma: f64) -> (f64, f64) {
-    let eval = |pre: &PhaseFit, post: &PhaseFit| {
-        let (t_c, _) = collision_time(pre, post, k.contact_m, k.window_s, Some(k.time_rule));
-        normal_restitution(pre, post, t_c)
+fn propagate(k: &Kinematics, sigma: f64) -> Result<(f64, f64)> {
+    let eval = |pre: &PhaseFit, post: &PhaseFit| -> Result<(f64, f64)> {
+        let (t_c, _) = collision_time(pre, post, k.contact_m, k.window_s, Some(k.time_rule))?;
+        Ok(normal_restitution(pre, post, t_c))
     };
     let (mut var_e, mut var_vn) = (0.0, 0.0);
     for phase in 0..2 {
@@ -388,7 +388,7 @@ fn propagate(k: &Kinematics, sigma: f64) -> (f64, f64) {
                     target.coef[j] += delta;
                     eval(&pre, &post)
                 };
-                let (plus, minus) = (shifted(h), shifted(-h));
+                let (plus, minus) = (shifted(h)?, shifted(-h)?);
                 *g = (
                     (plus.0 - minus.0) / (2.0 * h),
                     (plus.1 - minus.1) / (2.0 * h),
@@ -403,57 +403,124 @@ fn propagate(k: &Kinematics, sigma: f64) -> (f64, f64) {
             }
         }
     }
-    (var_e.sqrt(), var_vn.sqrt())
+    Ok((var_e.sqrt(), var_vn.sqrt()))
 }
 
-/// First crossing of f from > 0 to <= 0 on [lo, hi], by a scan and bisection to rounding.
-fn first_crossing(f: &impl Fn(f64) -> f64, lo: f64, hi: f64) -> Option<f64> {
+/// Iteration cap of the bisection and golden-section refinements below. Both stop when the
+/// bracket is down to 1e-15 of the window or of the time (whichever is larger): bisection needs
+/// about 43 halvings from a scan cell (1/200 of the window), golden section about 75 steps from
+/// two cells; 200 leaves a margin, and reaching it is an error.
+const REFINE_MAX_ITERATIONS: usize = 200;
+
+fn refine_error(what: &str, detail: String) -> Error {
+    Error::NoConvergence {
+        method: if what == "crossing" {
+            "bisection for the contact instant"
+        } else {
+            "golden-section search for the instant the fits meet"
+        },
+        detail,
+    }
+}
+
+/// Whether [x0, x1] is down to rounding: 1e-15 of |x| or of the window.
+fn narrow(x0: f64, x1: f64, window: f64) -> bool {
+    x1 - x0 <= 1e-15 * (x0.abs().max(x1.abs()) + window)
+}
+
+/// First crossing of f from > 0 to <= 0 on [lo, hi], by a scan and bisection to rounding; `None`
+/// if f does not cross, an error if f is NaN where it is evaluated or the bisection stalls.
+fn first_crossing(f: &impl Fn(f64) -> f64, lo: f64, hi: f64) -> Result<Option<f64>> {
     const N: usize = 200;
+    let nan = |t: f64| {
+        refine_error(
+            "crossing",
+            format!("the centre distance is NaN at t = {} s", Num(t)),
+        )
+    };
     let mut a = lo;
     let mut fa = f(a);
+    if fa.is_nan() {
+        return Err(nan(a));
+    }
     for i in 1..=N {
         let b = lo + (hi - lo) * i as f64 / N as f64;
         let fb = f(b);
+        if fb.is_nan() {
+            return Err(nan(b));
+        }
         if fa > 0.0 && fb <= 0.0 {
             let (mut x0, mut x1) = (a, b);
-            for _ in 0..100 {
+            for _ in 0..REFINE_MAX_ITERATIONS {
                 let m = 0.5 * (x0 + x1);
-                if m <= x0 || m >= x1 {
-                    break;
+                if narrow(x0, x1, hi - lo) || m <= x0 || m >= x1 {
+                    return Ok(Some(0.5 * (x0 + x1)));
                 }
-                if f(m) > 0.0 { x0 = m } else { x1 = m }
+                let fm = f(m);
+                if fm.is_nan() {
+                    return Err(nan(m));
+                }
+                if fm > 0.0 { x0 = m } else { x1 = m }
             }
-            return Some(0.5 * (x0 + x1));
+            return Err(refine_error(
+                "crossing",
+                format!(
+                    "{REFINE_MAX_ITERATIONS} halvings left [{}, {}] s",
+                    Num(x0),
+                    Num(x1)
+                ),
+            ));
         }
         a = b;
         fa = fb;
     }
-    None
+    Ok(None)
 }
 
-/// Minimiser of f on [lo, hi]: a scan, then golden-section refinement around the best point.
-fn argmin_scan(f: &impl Fn(f64) -> f64, lo: f64, hi: f64) -> f64 {
+/// Minimiser of f on [lo, hi]: a scan, then golden-section refinement around the best point; an
+/// error if f is NaN where it is evaluated or the refinement does not narrow to rounding.
+fn argmin_scan(f: &impl Fn(f64) -> f64, lo: f64, hi: f64) -> Result<f64> {
     const N: usize = 200;
+    let nan = |t: f64| {
+        refine_error(
+            "meet",
+            format!("the fits' mismatch is NaN at t = {} s", Num(t)),
+        )
+    };
     let h = (hi - lo) / N as f64;
-    let best = (0..=N)
-        .map(|i| lo + h * i as f64)
-        .min_by(|a, b| f(*a).total_cmp(&f(*b)))
-        .unwrap_or(lo);
-    let (mut a, mut b) = ((best - h).max(lo), (best + h).min(hi));
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    for _ in 0..100 {
-        let c = b - g * (b - a);
-        let d = a + g * (b - a);
-        if f(c) < f(d) {
-            b = d
-        } else {
-            a = c
+    let mut best = (lo, f(lo));
+    for i in 0..=N {
+        let t = lo + h * i as f64;
+        let v = f(t);
+        if v.is_nan() {
+            return Err(nan(t));
         }
-        if b - a <= 1e-15 * b.abs().max(1e-300) {
-            break;
+        if v < best.1 {
+            best = (t, v);
         }
     }
-    0.5 * (a + b)
+    let (mut a, mut b) = ((best.0 - h).max(lo), (best.0 + h).min(hi));
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    for _ in 0..REFINE_MAX_ITERATIONS {
+        if narrow(a, b, hi - lo) {
+            return Ok(0.5 * (a + b));
+        }
+        let c = b - g * (b - a);
+        let d = a + g * (b - a);
+        let (fc, fd) = (f(c), f(d));
+        if fc.is_nan() || fd.is_nan() {
+            return Err(nan(if fc.is_nan() { c } else { d }));
+        }
+        if fc < fd { b = d } else { a = c }
+    }
+    Err(refine_error(
+        "meet",
+        format!(
+            "{REFINE_MAX_ITERATIONS} steps left [{}, {}] s",
+            Num(a),
+            Num(b)
+        ),
+    ))
 }
 
 /// Eq. (8): Delta v = s d/(n_s dt sqrt N) = s * (subpixel size)/(dt sqrt N), with s the position
@@ -558,7 +625,7 @@ pub fn measure_collision(
         body(d2_m, k.r2_m, k.v_m_s[3], spins_rad_s[3])?,
     );
     let measured = walton::measure(&pre, &post)?;
-    let (e_err, v_n_err) = propagate(&k, sigma);
+    let (e_err, v_n_err) = propagate(&k, sigma)?;
     let e = measured.e;
     let dt = frames
         .windows(2)

@@ -179,3 +179,88 @@ fn bad_input_is_one_line_and_non_zero() {
     let o = run(&["predict", "--model", "vm", "--kappa", "-1"]);
     assert!(stderr(&o).contains("-1"));
 }
+
+#[test]
+fn plastic_at_huge_u_prints_the_right_numbers() {
+    // Reported: --u 1e308 printed e = 1 with 1 - e = NaN, and e = 0 above u ~ 1e246. mpmath
+    // (tests/fixtures/pm_reference.csv): e(1e308) = 1.184992992212371492...e-77 (C u^(-1/4):
+    // the 1/u terms are far below rounding), e(1e246) = 3.74727686672926466e-62.
+    let o = run(&[
+        "predict",
+        "--model",
+        "pm",
+        "--u",
+        "1e308,1e246",
+        "--format",
+        "csv",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    let rows: Vec<Vec<f64>> = out
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    for (row, want) in rows
+        .iter()
+        .zip([1.18499299221237149e-77, 3.74727686672926466e-62])
+    {
+        // 4 ulp: the closed form's bar (tests/plastic.rs).
+        assert!((row[1] / want - 1.0).abs() < 4.0 * f64::EPSILON, "{row:?}");
+        assert_eq!(row[2], 1.0, "1 - e of a tiny e rounds to 1: {row:?}");
+    }
+    assert!(!out.contains("NaN") && !out.contains("inf"), "{out}");
+}
+
+#[test]
+fn yield_speed_underflow_is_one_clear_error() {
+    // Reported: --sigma-y-pa 1e-130 made V_Y = 0 and printed e = 1 (fully elastic) where the truth
+    // is e -> 0. V_Y ~ sigma_y^(5/2) ~ 1e-345 m/s is below the smallest double: an error.
+    let o = run(&[
+        "predict",
+        "--model",
+        "pm",
+        "--material",
+        "nylon",
+        "--d-mm",
+        "25.4",
+        "--sigma-y-pa",
+        "1e-130",
+        "--v-m-s",
+        "1",
+    ]);
+    assert!(!o.status.success());
+    assert!(stdout(&o).is_empty(), "no half output: {}", stdout(&o));
+    let err = stderr(&o);
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(
+        err.contains("sigma_y = 1e-130 Pa") && err.contains("V_Y") && err.contains("underflow"),
+        "{err}"
+    );
+}
+
+#[test]
+fn viscoelastic_e_for_every_kappa_with_named_gaps() {
+    // The master curve gives e at any kappa; the ODE-only columns (contact time, extrema) are
+    // empty beyond the ODE's range, with a note on stderr naming why. Overlap rule at kappa = 1e6:
+    // e = A 1e-30, A = 5.158381704267685216 (mpmath).
+    let o = run(&[
+        "predict", "--model", "vm", "--kappa", "1e6,5", "--format", "csv",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    let first: Vec<&str> = out.lines().nth(1).unwrap().split(',').collect();
+    assert_eq!(first[0], "1000000");
+    assert_eq!(first[1].parse::<f64>().unwrap(), 5.158381704267685216e-30);
+    assert_eq!(&first[3..], ["", "", ""]);
+    let second: Vec<&str> = out.lines().nth(2).unwrap().split(',').collect();
+    assert!(
+        second[3..].iter().all(|c| c.parse::<f64>().is_ok()),
+        "{second:?}"
+    );
+    let err = stderr(&o);
+    assert!(
+        err.contains("note: kappa = 1000000") && err.contains("checked range"),
+        "{err}"
+    );
+}

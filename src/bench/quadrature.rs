@@ -18,8 +18,13 @@
 //! **Needs** u finite and >= 0. 1 - e comes from (W_i - W_r)/W_i and cancels as u -> 1 (where
 //! 1 - e ~ (3/8) q^2): this method is a comparator for the chart, not a way to compute 1 - e there.
 
-use crate::error::{Error, Result, non_negative};
+use crate::error::{Error, Num, Result, non_negative};
 use nalgebra::{DMatrix, SymmetricEigen};
+
+/// Cap of the Newton iteration for q: monotone Newton on a convex function, started within a
+/// factor of about 1.2 of the root, converges in about 6 steps (quadratically); 200 leaves a wide
+/// margin and still bounds the cost.
+const NEWTON_MAX_ITERATIONS: usize = 200;
 
 /// An n-point Gauss-Legendre rule on [0, 1].
 #[derive(Debug, Clone, PartialEq)]
@@ -122,18 +127,36 @@ impl WorkQuadrature {
         // (F(q0) >= hertz + q0 > 0 since (3/4) q0^2 = w_in) descends monotonically onto it, so
         // the first step that does not descend is rounding noise: stop there.
         let mut q = u * (8.0f64 / 15.0).sqrt();
-        for _ in 0..200 {
+        let mut converged = false;
+        for _ in 0..NEWTON_MAX_ITERATIONS {
             let f = hertz + plastic(q) - w_in;
             evals += n;
             let dq = f / (1.0 + 1.5 * q);
-            // Also stops on NaN.
-            if dq.is_nan() || dq <= 0.0 {
+            if !dq.is_finite() {
+                return Err(Error::NoConvergence {
+                    method: "quadrature Newton iteration for q",
+                    detail: format!("step {} at u = {}, q = {}", Num(dq), Num(u), Num(q)),
+                });
+            }
+            if dq <= 0.0 {
+                converged = true;
                 break;
             }
             q -= dq;
             if dq <= 4.0 * f64::EPSILON * q.abs() {
+                converged = true;
                 break;
             }
+        }
+        if !converged {
+            return Err(Error::NoConvergence {
+                method: "quadrature Newton iteration for q",
+                detail: format!(
+                    "{NEWTON_MAX_ITERATIONS} iterations at u = {} (q = {})",
+                    Num(u),
+                    Num(q)
+                ),
+            });
         }
         let p_star = 1.0 + 1.5 * q;
         let xi_star = 1.0 + q;

@@ -52,7 +52,7 @@ impl Outcome {
     }
 
     /// Every outcome, in the order of the figure's legend.
-    pub const ALL: [Outcome; 11] = [
+    pub const ALL: [Outcome; 13] = [
         Outcome::Ok,
         Outcome::Inaccurate,
         Outcome::NotFinite,
@@ -63,6 +63,8 @@ impl Outcome {
         Outcome::Failed(IntegrationFailure::NonFinite),
         Outcome::Failed(IntegrationFailure::Unphysical),
         Outcome::Failed(IntegrationFailure::PhaseIncomplete),
+        Outcome::Failed(IntegrationFailure::EventLocation),
+        Outcome::Failed(IntegrationFailure::OutOfRange),
         Outcome::OtherError,
     ];
 }
@@ -103,13 +105,8 @@ pub struct Cell {
 
 fn classify_error(err: &Error) -> Outcome {
     match err {
-        Error::Integration { .. } => Outcome::Failed(
-            err.integration_failure()
-                .unwrap_or(IntegrationFailure::Other),
-        ),
-        Error::InvalidParameter { expected, .. } if expected.contains("error bound") => {
-            Outcome::Refused
-        }
+        Error::Integration { kind, .. } => Outcome::Failed(*kind),
+        Error::BeyondErrorBound { .. } => Outcome::Refused,
         _ => Outcome::OtherError,
     }
 }
@@ -128,15 +125,19 @@ fn classify_number(
             format!("e = {e}, 1 - e = {one_minus_e}"),
         );
     }
-    // The worse of the absolute error of e and the relative error of 1 - e (they are computed
-    // separately by some methods). e itself is not held to the relative accuracy of 1 - e: next
-    // to 1 a double cannot resolve 1 - e = 1e-10 to 1e-6 of itself; that is 1 - e's job.
+    // The worse of the relative errors of e and of 1 - e (computed separately by some methods):
+    // the absolute error of e near e = 1, and its relative error where e is tiny (kappa -> inf,
+    // u -> inf), where an absolute 1e-6 would pass any number at all. e itself is not held to
+    // the relative accuracy of 1 - e: next to 1 a double cannot resolve 1 - e = 1e-10 to 1e-6 of
+    // itself; that is 1 - e's job. Below 1e-290 (down to the subnormals, where neither the
+    // reference nor the method can keep relative digits) the error is taken relative to 1e-290.
     let err_ome = if ome_ref > 0.0 {
         (one_minus_e - ome_ref).abs() / ome_ref
     } else {
         (one_minus_e - ome_ref).abs()
     };
-    let err = (e - e_ref).abs().max(err_ome);
+    let err_e = (e - e_ref).abs() / e_ref.clamp(1e-290, 1.0);
+    let err = err_e.max(err_ome);
     if err <= tol {
         (Outcome::Ok, err, String::new())
     } else {
@@ -166,6 +167,17 @@ pub fn kappa_grid(per_decade: usize, max_decade: i32) -> Vec<f64> {
             }
         })
         .collect()
+}
+
+/// The map's kappa: `per_decade` per decade from 1e-8 to 1e4 ([`kappa_grid`]), then every
+/// second decade to 1e300, and f64::MAX: the whole range a user can give.
+pub fn kappa_grid_wide(per_decade: usize) -> Vec<f64> {
+    let mut g = kappa_grid(per_decade, 4);
+    for d in (6..=300).step_by(2) {
+        g.push(format!("1e{d}").parse().expect("a literal"));
+    }
+    g.push(f64::MAX);
+    g
 }
 
 /// The viscoelastic map: every spec, both rules (where it applies), every kappa.

@@ -13,11 +13,15 @@
 //! ```
 //! Columns: the input (`v_m_s`, `kappa` or `u`), then `e`, `one_minus_e`, then per model
 //! `kappa, contact_time_s, max_overlap_m, max_force_n` (vm) or `u, v_yield_m_s` (pm); with
-//! `--kappa` the dimensionless `tau_contact, x_max, force_max`.
+//! `--kappa` the dimensionless `tau_contact, x_max, force_max`. e is a number for every finite
+//! kappa and u; the contact time and extrema come from the ODE, which covers kappa up to its
+//! checked range (1e4 overlap rule, 1e8 force rule): beyond it those cells are empty (CSV),
+//! null (JSON) or `-` (table), and a note on stderr says why.
 
 use super::{CliResult, Format, MaterialArgs};
 use restitution::contact::{Contact, Pair, Sphere};
 use restitution::data::fmt_num;
+use restitution::error::IntegrationFailure;
 use restitution::models::plastic::{self, Plastic};
 use restitution::models::viscoelastic::{
     self, ContactEnd, Integrator, OdeSettings, Viscoelastic, VmMethod,
@@ -72,7 +76,7 @@ pub struct Args {
     /// Speeds in units of the yield speed, V/V_Y (pm, no material needed)
     #[arg(long, value_name = "U", value_delimiter = ',', num_args = 1.., conflicts_with_all = ["v_m_s", "kappa"])]
     u: Vec<f64>,
-    /// How vm evaluates e: the master-curve table (ODE outside its range) or an ODE integrator
+    /// How vm evaluates e: the master curve (table and large-kappa laws, every kappa) or an ODE integrator
     #[arg(long, value_enum, default_value = "master")]
     method: MethodArg,
     /// Tolerance of the ODE integrators (rtol = atol)
@@ -86,10 +90,11 @@ fn parse_rule(s: &str) -> Result<ContactEnd, String> {
     s.parse()
 }
 
-/// A result table: column names and rows of numbers.
+/// A result table: column names and rows of numbers (`None`: not available, see `notes`).
 struct Out {
     columns: Vec<&'static str>,
-    rows: Vec<Vec<f64>>,
+    rows: Vec<Vec<Option<f64>>>,
+    notes: Vec<String>,
 }
 
 pub fn run(args: Args) -> CliResult {
@@ -112,7 +117,7 @@ pub fn run(args: Args) -> CliResult {
         }
         Model::Pm if !args.u.is_empty() => {
             check_all("--u", &args.u, |u| u >= 0.0, "a number >= 0")?;
-            pm_dimensionless(&args.u)
+            pm_dimensionless(&args.u)?
         }
         Model::Vm if !args.u.is_empty() => {
             return Err("--u is for --model pm; vm takes --kappa".into());
@@ -132,6 +137,9 @@ pub fn run(args: Args) -> CliResult {
             }
         }
     };
+    for note in &out.notes {
+        eprintln!("note: {note}");
+    }
     print!("{}", render(&out, args.format));
     Ok(())
 }
@@ -157,22 +165,50 @@ fn contact_from(args: &Args) -> Result<Contact, String> {
         (None, true) => Pair::on_wall(sphere, material),
         (None, false) => Pair::identical(sphere),
     };
-    Ok(pair.contact())
+    pair.try_contact().map_err(|e| e.to_string())
+}
+
+/// The ODE's extra figures (contact time and extrema), or `None` with a note when kappa is
+/// beyond the ODE's checked range; any other ODE failure is an error.
+fn extrema<T>(
+    kappa: f64,
+    rule: ContactEnd,
+    result: restitution::Result<T>,
+    notes: &mut Vec<String>,
+) -> Result<Option<T>, String> {
+    match result {
+        Ok(r) => Ok(Some(r)),
+        Err(e) if e.integration_failure() == Some(IntegrationFailure::OutOfRange) => {
+            notes.push(format!(
+                "kappa = {}: contact time and extrema left empty: {e}",
+                fmt_num(kappa)
+            ));
+            let _ = rule;
+            Ok(None)
+        }
+        Err(e) => Err(e.to_string()),
+    }
 }
 
 fn vm_dimensionless(args: &Args, method: &VmMethod, ode: &OdeSettings) -> Result<Out, String> {
     let mut rows = Vec::new();
+    let mut notes = Vec::new();
     for &k in &args.kappa {
         let e =
             viscoelastic::restitution(k, args.contact_end, method).map_err(|e| e.to_string())?;
-        let r = viscoelastic::rebound(k, args.contact_end, ode).map_err(|e| e.to_string())?;
-        rows.push(vec![
+        let r = extrema(
             k,
-            e.e,
-            e.one_minus_e,
-            r.tau_contact,
-            r.x_max,
-            r.force_max,
+            args.contact_end,
+            viscoelastic::rebound(k, args.contact_end, ode),
+            &mut notes,
+        )?;
+        rows.push(vec![
+            Some(k),
+            Some(e.e),
+            Some(e.one_minus_e),
+            r.map(|r| r.tau_contact),
+            r.map(|r| r.x_max),
+            r.map(|r| r.force_max),
         ]);
     }
     Ok(Out {
@@ -185,20 +221,21 @@ fn vm_dimensionless(args: &Args, method: &VmMethod, ode: &OdeSettings) -> Result
             "force_max",
         ],
         rows,
+        notes,
     })
 }
 
-fn pm_dimensionless(us: &[f64]) -> Out {
-    Out {
-        columns: vec!["u", "e", "one_minus_e"],
-        rows: us
-            .iter()
-            .map(|&u| {
-                let r = plastic::rebound_u(u);
-                vec![u, r.e, r.one_minus_e]
-            })
-            .collect(),
+fn pm_dimensionless(us: &[f64]) -> Result<Out, String> {
+    let mut rows = Vec::new();
+    for &u in us {
+        let r = plastic::try_rebound_u(u).map_err(|e| format!("--u {}: {e}", fmt_num(u)))?;
+        rows.push(vec![Some(u), Some(r.e), Some(r.one_minus_e)]);
     }
+    Ok(Out {
+        columns: vec!["u", "e", "one_minus_e"],
+        rows,
+        notes: Vec::new(),
+    })
 }
 
 fn vm_dimensional(
@@ -210,21 +247,27 @@ fn vm_dimensional(
     let eta = args.eta.ok_or("--model vm needs --eta (kg/(s m))")?;
     let model = Viscoelastic::new(contact, eta).map_err(|e| format!("--eta {eta}: {e}"))?;
     let mut rows = Vec::new();
+    let mut notes = Vec::new();
     for &v in &args.v_m_s {
-        let kappa = model.kappa(v);
+        let kappa = model
+            .try_kappa(v)
+            .map_err(|e| format!("--v-m-s {}: {e}", fmt_num(v)))?;
         let e = viscoelastic::restitution(kappa, args.contact_end, method)
             .map_err(|e| e.to_string())?;
-        let i = model
-            .impact(v, args.contact_end, ode)
-            .map_err(|e| e.to_string())?;
-        rows.push(vec![
-            v,
-            e.e,
-            e.one_minus_e,
+        let i = extrema(
             kappa,
-            i.contact_time_s,
-            i.max_overlap_m,
-            i.max_force_n,
+            args.contact_end,
+            model.impact(v, args.contact_end, ode),
+            &mut notes,
+        )?;
+        rows.push(vec![
+            Some(v),
+            Some(e.e),
+            Some(e.one_minus_e),
+            Some(kappa),
+            i.map(|i| i.contact_time_s),
+            i.map(|i| i.max_overlap_m),
+            i.map(|i| i.max_force_n),
         ]);
     }
     Ok(Out {
@@ -238,6 +281,7 @@ fn vm_dimensional(
             "max_force_n",
         ],
         rows,
+        notes,
     })
 }
 
@@ -245,19 +289,26 @@ fn pm_dimensional(args: &Args, contact: Contact) -> Result<Out, String> {
     let sy = args
         .sigma_y_pa
         .ok_or("--model pm needs --sigma-y-pa (Pa)")?;
-    let model = Plastic::new(contact, sy).map_err(|e| format!("--sigma-y-pa {sy}: {e}"))?;
+    let model = Plastic::new(contact, sy).map_err(|e| format!("--sigma-y-pa {sy:e}: {e}"))?;
     let vy = model.yield_velocity_m_s();
-    let rows = args
-        .v_m_s
-        .iter()
-        .map(|&v| {
-            let r = plastic::rebound_u(v / vy);
-            vec![v, r.e, r.one_minus_e, v / vy, vy]
-        })
-        .collect();
+    let mut rows = Vec::new();
+    for &v in &args.v_m_s {
+        let u = model
+            .u(v)
+            .map_err(|e| format!("--v-m-s {}: {e}", fmt_num(v)))?;
+        let r = plastic::rebound_u(u);
+        rows.push(vec![
+            Some(v),
+            Some(r.e),
+            Some(r.one_minus_e),
+            Some(u),
+            Some(vy),
+        ]);
+    }
     Ok(Out {
         columns: vec!["v_m_s", "e", "one_minus_e", "u", "v_yield_m_s"],
         rows,
+        notes: Vec::new(),
     })
 }
 
@@ -266,7 +317,10 @@ fn render(out: &Out, format: Format) -> String {
         Format::Csv => {
             let mut s = out.columns.join(",") + "\n";
             for row in &out.rows {
-                let cells: Vec<String> = row.iter().map(|&x| fmt_num(x)).collect();
+                let cells: Vec<String> = row
+                    .iter()
+                    .map(|x| x.map_or(String::new(), fmt_num))
+                    .collect();
                 s += &(cells.join(",") + "\n");
             }
             s
@@ -280,7 +334,7 @@ fn render(out: &Out, format: Format) -> String {
                         .columns
                         .iter()
                         .zip(row)
-                        .map(|(c, &x)| (c.to_string(), serde_json::json!(x)))
+                        .map(|(c, x)| (c.to_string(), serde_json::json!(x)))
                         .collect();
                     serde_json::Value::Object(map)
                 })
@@ -291,7 +345,11 @@ fn render(out: &Out, format: Format) -> String {
             let cells: Vec<Vec<String>> = out
                 .rows
                 .iter()
-                .map(|row| row.iter().map(|&x| super::readable(x)).collect())
+                .map(|row| {
+                    row.iter()
+                        .map(|x| x.map_or("-".to_string(), super::readable))
+                        .collect()
+                })
                 .collect();
             let widths: Vec<usize> = out
                 .columns

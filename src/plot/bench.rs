@@ -234,7 +234,7 @@ pub fn work_precision_svg(report: &BenchReport) -> Result<String, String> {
         let y_c = (ERROR_FLOOR / 3.0, REL_ERROR_CAP * 1e4);
         let mut c = log_panel(
             &panels[2],
-            "(c) plastic: error vs time (u in (1, 1e12]; above 10 drawn at 10)",
+            "(c) plastic: error vs time (u in (1, f64::MAX]; above 10 drawn at 10)",
             "time per evaluation (ns)",
             "max relative error",
             x_c,
@@ -352,6 +352,8 @@ fn outcome_color(o: Outcome) -> RGBColor {
         Outcome::Failed(F::NonFinite) => RGBColor(250, 150, 0),
         Outcome::Failed(F::Unphysical) => RGBColor(240, 210, 0),
         Outcome::Failed(F::PhaseIncomplete) => RGBColor(140, 90, 40),
+        Outcome::Failed(F::EventLocation) => RGBColor(230, 120, 180),
+        Outcome::Failed(F::OutOfRange) => RGBColor(150, 190, 240),
         Outcome::Failed(F::Other) | Outcome::OtherError => RGBColor(90, 90, 90),
     }
 }
@@ -359,7 +361,7 @@ fn outcome_color(o: Outcome) -> RGBColor {
 fn outcome_label(o: Outcome) -> &'static str {
     use crate::error::IntegrationFailure as F;
     match o {
-        Outcome::Ok => "ok (error <= 1e-6)",
+        Outcome::Ok => "ok (relative error <= 1e-6)",
         Outcome::Inaccurate => "WRONG NUMBER: error > 1e-6 (loose rows: 100 tol), no error value",
         Outcome::NotFinite => "WRONG NUMBER: NaN, no error value",
         Outcome::Refused => "refused: error bound above 1e-6 (error value)",
@@ -371,6 +373,8 @@ fn outcome_label(o: Outcome) -> &'static str {
             "unphysical end: e outside (0, 1] or not separating (error value)"
         }
         Outcome::Failed(F::PhaseIncomplete) => "phase did not end (error value)",
+        Outcome::Failed(F::EventLocation) => "event not located (error value)",
+        Outcome::Failed(F::OutOfRange) => "beyond the checked kappa range (error value)",
         Outcome::Failed(F::Other) | Outcome::OtherError => "other error value",
     }
 }
@@ -406,9 +410,37 @@ fn row_key(c: &Cell) -> String {
     format!("{}{setting}{rule}{role}", c.method)
 }
 
-/// Cell edges in log10(x): midpoints between neighbouring grid values.
+/// The map's x coordinate: log10(x), compressed eightfold above 1e4, so that the dense grid up to
+/// 1e4 stays readable next to the sparse one reaching f64::MAX.
+fn squash(x: f64) -> f64 {
+    let l = x.log10();
+    if l <= SQUASH_FROM {
+        l
+    } else {
+        SQUASH_FROM + (l - SQUASH_FROM) / SQUASH
+    }
+}
+
+const SQUASH_FROM: f64 = 4.0;
+const SQUASH: f64 = 8.0;
+
+/// The decade shown at map coordinate c (inverse of [`squash`]), when it is a whole one.
+fn unsquash_label(c: f64) -> String {
+    let l = if c <= SQUASH_FROM {
+        c
+    } else {
+        SQUASH_FROM + (c - SQUASH_FROM) * SQUASH
+    };
+    if (l - l.round()).abs() < 1e-6 {
+        format!("1e{}", l.round() as i32)
+    } else {
+        String::new()
+    }
+}
+
+/// Cell edges in map coordinates: midpoints between neighbouring grid values.
 fn edges(xs: &[f64]) -> Vec<f64> {
-    let l: Vec<f64> = xs.iter().map(|x| x.log10()).collect();
+    let l: Vec<f64> = xs.iter().map(|&x| squash(x)).collect();
     let mut e = Vec::with_capacity(l.len() + 1);
     for i in 0..=l.len() {
         let v = if i == 0 {
@@ -453,13 +485,7 @@ fn map_panel(
         .axis_desc_style(("sans-serif", 20))
         .label_style(("sans-serif", 16))
         .x_labels(14)
-        .x_label_formatter(&|v| {
-            if (v - v.round()).abs() < 1e-9 {
-                format!("1e{}", v.round() as i32)
-            } else {
-                String::new()
-            }
-        })
+        .x_label_formatter(&|v| unsquash_label(*v))
         .y_labels(rows.len())
         .y_label_formatter(&|v| {
             let i = v.round();
@@ -483,7 +509,7 @@ fn map_panel(
         }))
         .map_err(err_str)?;
     if let Some((x, text)) = mark {
-        let lx = x.log10();
+        let lx = squash(x);
         chart
             .draw_series(DashedLineSeries::new(
                 vec![(lx, -0.5), (lx, n - 0.5)],
@@ -531,7 +557,7 @@ pub fn stability_svg(report: &BenchReport) -> Result<String, String> {
         let (title, rest) = root.split_vertically(50);
         title
             .titled(
-                "Stability map: where each method fails, and how (threshold: error <= 1e-6 in e and relative in 1 - e)",
+                "Stability map: where each method fails, and how (threshold: relative error <= 1e-6 in e and in 1 - e)",
                 ("sans-serif", 22),
             )
             .map_err(err_str)?;
@@ -540,15 +566,18 @@ pub fn stability_svg(report: &BenchReport) -> Result<String, String> {
         map_panel(
             &top,
             "viscoelastic model: dimensionless damping kappa",
-            "kappa (dimensionless damping)",
+            "kappa (dimensionless damping; log scale, compressed 8 times above 1e4)",
             &vm,
             |c| c.x,
-            Some((100.0, "end of the master table: kappa = 100")),
+            Some((
+                10.0,
+                "master curve: table below kappa = 10, large-kappa laws above",
+            )),
         )?;
         map_panel(
             &mid,
             "plastic model: u = V/V_Y at the mpmath fixture's points (comparators are kept to show their failure)",
-            "u - 1",
+            "u - 1 (log scale, compressed 8 times above 1e4)",
             &pm,
             |c| c.x - 1.0,
             None,

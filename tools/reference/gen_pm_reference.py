@@ -54,6 +54,12 @@ U_VALUES = ["0.5", "1", "1+1e-12", "1+1e-9", "1+1e-6", "1+1e-3", "1.01", "1.1", 
 # printed double is the value used).
 U_VALUES += [repr(1.0 + 10.0 ** (-k / 4)) for k in range(1, 48)]
 U_VALUES += [repr(10.0 ** (k / 8)) for k in range(1, 97)]
+# Large u, up to f64::MAX: around the Rust code's switch to the large-u form at u = 1e6 (the
+# doubles on either side of it), where the closed form as written would overflow (1 + 1.5 q near
+# u = 1.2e308; 30 u^2 near 3e153), and the largest double.
+U_VALUES += ["999999.9999999999", "1000000.0000000001", "1e7", "1e8", "1e10", "1e15", "1e20",
+             "1e50", "1e100", "1e153", "1e154", "1e200", "1e246", "1e300", "1e307",
+             "1.2e308", "1.7976931348623157e308"]
 
 DPS_A = 50
 DPS_B = 90
@@ -235,6 +241,21 @@ def main():
             check(abs(dev) < abs(prev), "e u^(1/4) -> C monotonically (u=%s)" % spec)
         prev = dev
     check(abs(prev) < mpf("1e-5"), "e u^(1/4) within 1e-5 of C at u = 1e12")
+    # large-u series (Rust: plastic.rs): e u^(1/4)/C = 1 + a1/u + a2/u^2 + a3/u^3 + a4/u^4 + ...
+    a = [-sqrt30 / 48, -mpf(23) / 768, -91 * sqrt30 / 36864, mpf(5035) / 1179648]
+    for spec in ["1e6", "1e9", "1e12"]:  # (at dps 50, u^4 times the rest needs u^4 << 1e50)
+        u = mpf(u_double(spec))
+        e, _ = closed_form(u)
+        s3 = 1 + a[0] / u + a[1] / u ** 2 + a[2] / u ** 3
+        rest = (e * u ** (mpf(1) / 4) / C - s3) * u ** 4
+        print("  u=%-6s (e u^(1/4)/C - (1 + a1/u + a2/u^2 + a3/u^3)) u^4 = %s (-> a4 = 5035/1179648 = %s)"
+              % (spec, mpmath.nstr(rest, 12), mpmath.nstr(a[3], 12)))
+        check(abs(rest / a[3] - 1) < mpf(10) / u, "large-u series through u^-3 leaves a4/u^4 at u=%s" % spec)
+    u = mpf(u_double("1e6"))
+    e, _ = closed_form(u)
+    s3 = C * u ** (-mpf(1) / 4) * (1 + a[0] / u + a[1] / u ** 2 + a[2] / u ** 3)
+    check(rel(s3, e) < mpf("1e-26"), "four-term large-u form at the switch u = 1e6: rel error %s (< 1e-26)"
+          % mpmath.nstr(rel(s3, e), 3))
     # near u = 1: 1 - e = (3/8) q^2 (1 + O(q))
     u = mpf(u_double("1+1e-9"))
     q = 4 * (u * u - 1) / (mpmath.sqrt(30 * u * u - 5) + 5)

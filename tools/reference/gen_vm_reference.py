@@ -561,6 +561,7 @@ def main():
             f.write("start_series_t72,%s\n" % fmt(mpf(-4) / 35, 30))
         print("wrote %s" % os.path.relpath(path, REPO))
 
+    failures += large_kappa(results)
     print("total runtime %.1f s" % (time.time() - t_start))
     if failures:
         print("FAILED CHECKS:")
@@ -570,5 +571,269 @@ def main():
     print("all checks passed")
 
 
+
+# --------------------------------------------------------------------------------------
+# Large kappa (docs/derivations/vm_large_kappa.md)
+# --------------------------------------------------------------------------------------
+#
+# Both large-kappa laws come from rescalings of the same equation.  With coefficients
+# (a, b) the sigma-system of x'' = -a x^(3/2) - b x^(1/2) x' is
+#     dr/dsigma = p/2,  dp/dsigma = -(a r^4 + b r^2 p),  dt/dsigma = r.
+#  * Force rule: x = kappa^(-2/3) xi, t = kappa^(-2/3) s gives a = eps = kappa^(-5/3), b = 1,
+#    xi(0) = 0, xi'(0) = 1 (velocities are not rescaled), and the force-rule end
+#    eps xi + xi' = 0, so e = -xi'(end) = eps xi_end.
+#  * Overlap rule: x = kappa^(-4) X, t = kappa T gives a = b = 1 with X'(0) = kappa^5: the
+#    parameter-free equation.  Its slow manifold (P ~ -X - X^(1/2) as X -> infinity) attracts
+#    every trajectory at the rate X^(1/2), so starting anywhere near it at a large X0 and
+#    integrating to X = 0 gives A = -P(end) independently of kappa, and e = A kappa^-5.
+
+LARGE_FORCE_FIXTURE_KAPPAS = ["10", "20", "50", "100", "300", "1e3", "3e3", "1e4", "1e5", "1e6",
+                              "1e7", "1e8", "1e10", "1e12", "1e15", "1e20", "1e30"]
+# Force-rule table over y = ln kappa on [ln FORCE_TABLE_KAPPA_MIN, ln FORCE_TABLE_KAPPA_MAX]:
+# FORCE_TABLE_PIECES Chebyshev pieces of degree FORCE_TABLE_DEGREE (nodes written for
+# examples/gen_master_curve.rs, which builds and checks the Rust table from them).
+FORCE_TABLE_KAPPA_MIN = 10.0
+FORCE_TABLE_KAPPA_MAX = 1e7
+FORCE_TABLE_PIECES = 10
+FORCE_TABLE_DEGREE = 16
+DPS_LARGE = 28
+
+
+def taylor_coeffs_ab(r0, p0, t0, a, b, N):
+    """Taylor coefficients of r, p, t for dp/dsigma = -(a r^4 + b r^2 p)."""
+    fsum = mp.fsum
+    R = [r0]; P = [p0]; T = [t0]
+    A2 = []; B4 = []; C = []
+    for n in range(N):
+        A2.append(fsum(R[k] * R[n - k] for k in range(n + 1)))
+        B4.append(fsum(A2[k] * A2[n - k] for k in range(n + 1)))
+        C.append(fsum(A2[k] * P[n - k] for k in range(n + 1)))
+        m = n + 1
+        R.append(P[n] / (2 * m))
+        P.append(-(a * B4[n] + b * C[n]) / m)
+        T.append(R[n] / m)
+    return R, P, T
+
+
+def integrate_ab(r, p, a, b, end, dps, max_steps=20000):
+    """Integrates the (a, b) sigma-system from (r, p, t = 0) until the event `end`
+    ("force": a r|r| + b' p with the force-rule function eps xi + xi', i.e. a r|r| + p;
+    "overlap": r) crosses from > 0 to <= 0.  Returns (r, p, t) at the event, to working
+    precision, and the steps taken."""
+    with mp.workdps(dps):
+        a, b, r, p = mpf(a), mpf(b), mpf(r), mpf(p)
+        t = mpf(0)
+        N = int(math.ceil(1.15 * (dps + 4))) + 4
+        log_eps = -(dps + 4) * math.log(10.0)
+        for steps in range(1, max_steps + 1):
+            R, P, T = taylor_coeffs_ab(r, p, t, a, b, N)
+            h = choose_step([R, P, T], N, log_eps)
+            rs = lambda s: horner(R, s)
+            ps = lambda s: horner(P, s)
+            if end == "force":
+                f = lambda s: a * rs(s) * abs(rs(s)) + ps(s)
+            else:
+                f = rs
+            M = 16
+            grid = [h * j / M for j in range(M + 1)]
+            vals = [f(s) for s in grid]
+            for j in range(M):
+                if vals[j] > 0 and vals[j + 1] <= 0:
+                    s = refine_root(f, grid[j], grid[j + 1])
+                    return rs(s), ps(s), horner(T, s), steps
+            r, p, t = rs(h), ps(h), horner(T, h)
+        raise RuntimeError("integrate_ab: no end within %d steps" % max_steps)
+
+
+def force_large(kappa, dps):
+    """Force rule at kappa by the rescaled problem: returns (e, xi_end, e from -p)."""
+    with mp.workdps(dps + 10):
+        eps = mpf(kappa) ** (mpf(-5) / 3)
+    r, p, t, _ = integrate_ab(0, 1, eps, 1, "force", dps)
+    with mp.workdps(dps):
+        xi_end = r * r
+        return eps * xi_end, xi_end, -p, eps
+
+
+def overlap_a(x0, dps):
+    """A = lim e kappa^5 from the parameter-free equation, started near its slow manifold at X0."""
+    with mp.workdps(dps):
+        x0 = mpf(x0)
+        r0 = mpmath.sqrt(x0)
+        p0 = -(x0 + r0)
+    r, p, t, steps = integrate_ab(r0, p0, 1, 1, "overlap", dps, max_steps=200000)
+    return -p, steps
+
+
+def force_constants(dps):
+    """xi_m, lambda, the constant a of the undamped... of the eps = 0 approach, and c_f."""
+    with mp.workdps(dps):
+        xi_m = (mpf(3) / 2) ** (mpf(2) / 3)
+        lam = mpmath.sqrt(xi_m)
+        # xi0' = 1 - (2/3) xi0^(3/2): xi_m - xi0 ~ a_c exp(-lam s); a_c = exp(lam s_c),
+        # s_c = int_0^xi_m [1/(1 - G) - 1/(lam (xi_m - xi))] dxi + ln(xi_m)/lam.
+        # The integrand is finite at xi_m but formed by cancellation there: evaluate it with
+        # 40 extra digits and stop 1e-30 short of xi_m (the rest is below 1e-29).
+        G = lambda x: mpf(2) / 3 * x ** mpf(1.5)
+
+        def integrand(x):
+            with mp.workdps(dps + 40):
+                return 1 / (1 - G(x)) - 1 / (lam * (xi_m - x))
+        cut = xi_m * (1 - mpf(10) ** -30)
+        s_c = mp.quad(integrand, [0, xi_m / 2, cut]) + mpmath.log(xi_m) / lam
+        a_c = mpmath.exp(lam * s_c)
+        return xi_m, lam, a_c
+
+
+def force_asymptote(kappa, c_f, dps):
+    """e kappa^(5/3) = xi_m (1 - (2/lam) eps ln(1/eps) + c_f eps), eps = kappa^(-5/3)."""
+    with mp.workdps(dps):
+        xi_m, lam, _ = force_constants(dps)
+        eps = mpf(kappa) ** (mpf(-5) / 3)
+        return xi_m * (1 - 2 / lam * eps * mpmath.log(1 / eps) + c_f * eps)
+
+
+def large_kappa(results=None):
+    """Large-kappa constants, fixture and force-table nodes.  `results` (optional) are the main
+    table's integrations, for the consistency checks at kappa = 10..100."""
+    failures = []
+
+    def check(cond, msg):
+        print(("  PASS  " if cond else "  FAIL  ") + msg)
+        if not cond:
+            failures.append(msg)
+
+    t0 = time.time()
+    print("== Overlap rule, large kappa: A from the parameter-free equation ==")
+    a1, n1 = overlap_a("1e4", 50)
+    a2, n2 = overlap_a("4e4", 50)
+    print("  A (X0 = 1e4, %d steps) = %s" % (n1, mpmath.nstr(a1, 45)))
+    print("  A (X0 = 4e4, %d steps) = %s" % (n2, mpmath.nstr(a2, 45)))
+    check(rel(a1, a2) < mpf(10) ** -44, "A independent of the start X0 (rel %s)" % mpmath.nstr(rel(a1, a2), 3))
+    A = a2
+    if results is not None:
+        for ks in ["5", "7", "10", "20", "50", "100"]:
+            with mp.workdps(DPS_HI):
+                ek5 = results[ks].out["overlap"]["e"] * mpf(ks) ** 5
+                print("  kappa=%-4s e kappa^5 / A - 1 = %s" % (ks, mpmath.nstr(ek5 / A - 1, 3)))
+                # The corrections are exponentially small, ~exp(-2 lambda kappa^(5/3)) up to a
+                # prefactor (docs/derivations/vm_large_kappa.md): 3.5e-36 at kappa = 10, below the
+                # dps-45 noise from kappa = 20 on.
+                bound = mpf(10) ** -(DPS_HI - 5) if mpf(ks) >= 20 else mpf(10) ** -34
+                if mpf(ks) >= 10:
+                    check(rel(ek5, A) < bound,
+                          "kappa=%s: full ODE e kappa^5 == A (rel %s)" % (ks, mpmath.nstr(rel(ek5, A), 3)))
+
+    print("== Force rule, large kappa: rescaled problem ==")
+    # 120 digits: c_f below is extracted at eps = 1e-50, where xi_m must be known far beyond 50 digits.
+    xi_m, lam, a_c = force_constants(120)
+    print("  xi_m = (3/2)^(2/3) = %s, lambda = xi_m^(1/2) = %s" % (mpmath.nstr(xi_m, 30), mpmath.nstr(lam, 30)))
+    print("  a (eps = 0 approach xi_m - xi0 ~ a exp(-lambda s)) = %s" % mpmath.nstr(a_c, 30))
+    if results is not None:
+        for ks in ["10", "20", "50", "100"]:
+            e, xi_end, e_p, eps = force_large(ks, DPS_HI)
+            with mp.workdps(DPS_HI):
+                ref = results[ks].out["force"]["e"]
+                check(rel(e, ref) < mpf(10) ** -(DPS_HI - 8),
+                      "kappa=%s: rescaled e == full ODE e (rel %s)" % (ks, mpmath.nstr(rel(e, ref), 3)))
+    # c_f from tiny eps, where the remainder O(eps^2 ln^2 eps) is far below the working precision
+    cs = {}
+    for kexp in (24, 30):
+        kappa = mpf(10) ** kexp
+        e, xi_end, e_p, eps = force_large(kappa, 100)
+        with mp.workdps(100):
+            check(rel(e, e_p) < mpf(10) ** -80, "kappa=1e%d: e = eps xi_end == -p_end" % kexp)
+            cs[kexp] = (xi_end / xi_m - 1 + 2 / lam * eps * mpmath.log(1 / eps)) / eps
+            print("  kappa=1e%d: (xi_end/xi_m - 1 + (2/lambda) eps ln(1/eps))/eps = %s"
+                  % (kexp, mpmath.nstr(cs[kexp], 30)))
+    c_f = cs[30]
+    with mp.workdps(50):
+        check(abs(cs[24] - cs[30]) < mpf(10) ** -25, "c_f stable between kappa = 1e24 and 1e30 (%s)"
+              % mpmath.nstr(abs(cs[24] - cs[30]), 3))
+        print("  c_f = %s; compare -(ln a)/lambda = %s (the rest is the O(eps) shift c1/xi_m)"
+              % (mpmath.nstr(c_f, 30), mpmath.nstr(-mpmath.log(a_c) / lam, 30)))
+
+    print("== Force rule: fixture and asymptote error ==")
+    rows = []
+    for ks in LARGE_FORCE_FIXTURE_KAPPAS:
+        kf = float(ks)
+        e, xi_end, e_p, eps = force_large(kf, DPS_LARGE)
+        with mp.workdps(DPS_LARGE):
+            check(rel(e, e_p) < mpf(10) ** -(DPS_LARGE - 6), "kappa=%s: e = eps xi_end == -p_end" % ks)
+            h = xi_end
+            asym = force_asymptote(kf, c_f, DPS_LARGE)
+            lead = xi_m
+            print("  kappa=%-5s e=%s  e kappa^(5/3)=%s  rel err: leading %s, 3-term asymptote %s"
+                  % (ks, mpmath.nstr(e, 20), mpmath.nstr(h, 20), mpmath.nstr(lead / h - 1, 3),
+                     mpmath.nstr(asym / h - 1, 3)))
+            rows.append((ks, e, h, asym / h - 1))
+
+    print("== Force-rule table nodes ==")
+    y0 = math.log(FORCE_TABLE_KAPPA_MIN)
+    y1 = math.log(FORCE_TABLE_KAPPA_MAX)
+    w = (y1 - y0) / FORCE_TABLE_PIECES
+    n = FORCE_TABLE_DEGREE + 1
+    nodes = []
+    for i in range(FORCE_TABLE_PIECES):
+        a_ = y0 + i * w
+        xs = [math.cos(math.pi * (k + 0.5) / n) for k in range(n)]
+        for k, x in enumerate(xs):
+            nodes.append(("node", i, k, math.exp(a_ + 0.5 * w * (x + 1))))
+        for m in range(2 * n + 1):
+            x = -1 + 2 * m / (2 * n)
+            nodes.append(("check", i, m, math.exp(a_ + 0.5 * w * (x + 1))))
+    node_rows = []
+    for kind, i, k, kf in nodes:
+        e, xi_end, e_p, eps = force_large(kf, DPS_LARGE - 4)
+        node_rows.append((kind, i, k, kf, xi_end))
+    print("  %d node and check values in %.0f s" % (len(node_rows), time.time() - t0))
+
+    # ---- write ----
+    path = os.path.join(FIXTURES, "vm_large_kappa.csv")
+    with open(path, "w") as f:
+        f.write("rule,kappa,e,e_kappa_pow,asymptote_rel_error\n")
+        for ks in ["10", "20", "50", "100", "1e3", "1e4", "1e10", "1e30", "1e60", "1e64", "1e100",
+                   "1e300", "1.7976931348623157e308"]:
+            with mp.workdps(60):
+                e = A * mpf(float(ks)) ** -5
+                f.write("overlap,%s,%s,%s,0\n" % (ks, fmt(e, 30), fmt(A, 30)))
+        for ks, e, h, asym_err in rows:
+            f.write("force,%s,%s,%s,%s\n" % (ks, fmt(e, 30), fmt(h, 30), mpmath.nstr(asym_err, 3)))
+        # the asymptote alone, far beyond any integration, for the rounding tests
+        for ks in ["1e50", "1e100", "1e150", "1e180", "1e190", "1e193", "1e194", "1e300",
+                   "1.7976931348623157e308"]:
+            with mp.workdps(60):
+                h = force_asymptote(float(ks), c_f, 60)
+                e = h * mpf(float(ks)) ** (mpf(-5) / 3)
+            f.write("force,%s,%s,%s,asymptote\n" % (ks, fmt(e, 30), fmt(h, 30)))
+    print("wrote %s" % os.path.relpath(path, REPO))
+    path = os.path.join(FIXTURES, "vm_force_table_nodes.csv")
+    with open(path, "w") as f:
+        f.write("# xi_end = e kappa^(5/3) of the force rule (mpmath, dps %d) at the Chebyshev nodes\n"
+                "# in y = ln kappa of %d pieces on [ln %r, ln %r], degree %d, and at check points\n"
+                % (DPS_LARGE - 4, FORCE_TABLE_PIECES, FORCE_TABLE_KAPPA_MIN, FORCE_TABLE_KAPPA_MAX,
+                   FORCE_TABLE_DEGREE))
+        f.write("kind,piece,index,kappa,e_kappa_pow\n")
+        for kind, i, k, kf, h in node_rows:
+            f.write("%s,%d,%d,%r,%s\n" % (kind, i, k, kf, fmt(h, 25)))
+    print("wrote %s" % os.path.relpath(path, REPO))
+    path = os.path.join(FIXTURES, "vm_large_kappa_constants.csv")
+    with open(path, "w") as f:
+        f.write("name,value\n")
+        f.write("overlap_a,%s\n" % fmt(A, 40))
+        f.write("force_xi_m,%s\n" % fmt(xi_m, 40))
+        f.write("force_lambda,%s\n" % fmt(lam, 40))
+        f.write("force_approach_a,%s\n" % fmt(a_c, 30))
+        f.write("force_c_f,%s\n" % fmt(c_f, 30))
+    print("wrote %s" % os.path.relpath(path, REPO))
+    print("large kappa: %.1f s" % (time.time() - t0))
+    return failures
+
+
 if __name__ == "__main__":
-    main()
+    if "--large-kappa" in sys.argv:
+        # Only the large-kappa part (without the main table's consistency checks).
+        if large_kappa():
+            sys.exit(1)
+    else:
+        main()

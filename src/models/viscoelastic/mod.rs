@@ -4,25 +4,17 @@
 //! in the dimensionless form x'' = -x^(3/2) - kappa x^(1/2) x', x(0) = 0, x'(0) = 1 (PHYSICS.md §2:
 //! the paper's Eq. 10 omits the sign of the force), and returns e = -x'(end) for either end-of-contact
 //! rule ([`ContactEnd`]).
+//!//! **Method** ([`ode`]): the ODE in phases, with the independent variable r = x^(1/2) where x
+//! is near 0, so that Runge-Kutta methods keep their order; events located by safeguarded Newton
+//! steps ([`events`]).
 //!
-//! **Method.** The right side contains x^(1/2), so the solution is not analytic in t where x = 0:
-//! it has t^(5/2) terms at the start and (t_end - t)^(5/2) terms at the overlap-rule end, and a
-//! Runge-Kutta method in t loses its order there. We therefore change the independent variable:
-//! - loading (x' > 1/2): r = x^(1/2), with dp/dr = -2 r^2 (r^2 + kappa p)/p, dt/dr = 2r/p;
-//! - around the turning point: time t, where x is bounded away from 0;
-//! - unloading (x below its value at the first switch): r again, integrated down to r = 0.
-//!
-//! In r the solution is analytic at both ends (p is bounded away from 0 there), so the methods keep
-//! their order and the overlap-rule end is exactly r = 0: no event needs locating. The switches
-//! happen at accepted steps, so they introduce no error. The events that do need locating (the
-//! force-rule end x + kappa p = 0, the turning point p = 0, the force maximum) are found by
-//! safeguarded Newton steps (Illinois regula falsi, Dowell & Jarratt 1971, as the fallback) on
-//! re-integrations from the last accepted step before the event.
-//!
-//! For relative accuracy of 1 - e as kappa -> 0 the dissipated work is integrated as a third
-//! component, J = int x^(1/2) x'^2 dt (dJ/dr = 2 r^2 p), and e comes from the energy balance
-//! e^2 = 1 - 2 kappa J - (4/5) x_end^(5/2) whenever e > 1/2 (below that, e = -p_end directly, which
-//! keeps the relative accuracy of a tiny e at large kappa).
+//! **Every kappa >= 0** ([`restitution`] with [`VmMethod::Master`]): the master-curve table for
+//! kappa <= 10, then the large-kappa laws (docs/physics.md §2, derived in
+//! docs/derivations/vm_large_kappa.md): for the overlap rule e = A kappa^-5 exactly up to
+//! exponentially small terms; for the force rule a table of e kappa^(5/3) in ln kappa up to
+//! kappa = 1e7 and e = xi_m kappa^(-5/3) (1 - (2/lambda) eps ln(1/eps) + c_f eps) beyond, eps =
+//! kappa^(-5/3) ([`asymptotic`]). The small-kappa end is the table's h(0) = C1: 1 - e = C1 kappa
+//! keeps its relative accuracy down to the smallest kappa.
 //!
 //! **Needs** kappa >= 0 finite. Integrators: Dop853 and Dopri5 from `ode_solvers` (adaptive,
 //! sparse output), and classical RK4 at a fixed step (our own loop: `ode_solvers::Rk4` overshoots
@@ -31,26 +23,30 @@
 //! **Reference values**: `tests/fixtures/vm_reference.csv` (mpmath Taylor integration at 30-40
 //! digits, `tools/reference/`); the tests there bound the error of every setting.
 
-use crate::contact::Contact;
-use crate::error::{Error, Result, non_negative};
-use nalgebra::Vector4;
-use ode_solvers::dop_shared::IntegrationError;
-use ode_solvers::{Dop853, Dopri5, OutputType, System};
+pub mod asymptotic;
+pub mod events;
+mod force_table;
+pub mod master;
+mod master_table;
+pub mod ode;
+pub mod series;
+pub mod settings;
+pub mod si;
+mod stepper;
+
+pub use ode::{rebound, restitution_ode};
+pub use settings::{
+    Integrator, ODE_KAPPA_MAX_FORCE, ODE_KAPPA_MAX_OVERLAP, OdeSettings, Rebound, ode_kappa_max,
+};
+pub use si::{Impact, Viscoelastic};
+
+use crate::error::Result;
 use std::fmt;
 use std::str::FromStr;
 
-pub mod master;
-mod master_table;
-pub mod series;
-
-// The fourth component carries the independent variable, so that the system is autonomous:
-// ode_solvers 0.6's Dop853 tableau has c_12 = 0 where DOP853 needs c_12 = 1, which silently
-// degrades it to first order on non-autonomous systems (found here: with r explicit in the right
-// side it needed 1e5 steps at tol 1e-10 and missed 1e-9 accuracy).
-type State = Vector4<f64>;
-
 /// When the contact ends (PHYSICS.md §2).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, strum::IntoStaticStr, strum::VariantArray)]
+#[strum(serialize_all = "lowercase")]
 pub enum ContactEnd {
     /// The paper's rule: the first t > 0 with delta = 0.
     Overlap,
@@ -62,10 +58,7 @@ impl ContactEnd {
     pub const ALL: [ContactEnd; 2] = [ContactEnd::Overlap, ContactEnd::Force];
 
     pub fn name(self) -> &'static str {
-        match self {
-            ContactEnd::Overlap => "overlap",
-            ContactEnd::Force => "force",
-        }
+        self.into()
     }
 }
 
@@ -78,675 +71,19 @@ impl fmt::Display for ContactEnd {
 impl FromStr for ContactEnd {
     type Err = String;
     fn from_str(s: &str) -> std::result::Result<Self, String> {
-        match s {
-            "overlap" => Ok(ContactEnd::Overlap),
-            "force" => Ok(ContactEnd::Force),
-            _ => Err(format!(
-                "'{s}' is not a contact-end rule: expected overlap or force"
-            )),
-        }
+        use strum::VariantArray;
+        ContactEnd::VARIANTS
+            .iter()
+            .find(|r| r.name() == s)
+            .copied()
+            .ok_or_else(|| {
+                let names: Vec<&str> = ContactEnd::VARIANTS.iter().map(|r| r.name()).collect();
+                format!(
+                    "'{s}' is not a contact-end rule: expected {}",
+                    names.join(" or ")
+                )
+            })
     }
-}
-
-/// The ODE integrator.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Integrator {
-    /// Dormand-Prince 8(5,3) (Hairer, Norsett & Wanner, Solving ODEs I, 1993).
-    Dop853,
-    /// Dormand-Prince 5(4).
-    Dopri5,
-    /// Classical fourth-order Runge-Kutta with a fixed step `h` in each phase's variable.
-    Rk4 { h: f64 },
-}
-
-impl Integrator {
-    pub fn name(self) -> &'static str {
-        match self {
-            Integrator::Dop853 => "dop853",
-            Integrator::Dopri5 => "dopri5",
-            Integrator::Rk4 { .. } => "rk4",
-        }
-    }
-}
-
-/// Integrator and its accuracy knobs.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct OdeSettings {
-    pub integrator: Integrator,
-    /// Relative and absolute tolerance of the adaptive methods (all state components are O(1)).
-    pub rtol: f64,
-    pub atol: f64,
-    /// Steps allowed per phase before giving up with an error.
-    pub max_steps: u32,
-    /// Let the adaptive methods' stiffness detector abort the run (off by default: at large kappa
-    /// the unloading tail is mildly stiff, and the explicit methods still finish correctly).
-    pub stiffness_check: bool,
-}
-
-impl OdeSettings {
-    /// The default: Dop853 at rtol = atol = 1e-11, the cheapest tolerance that meets
-    /// |error in e| <= 1e-10 and a relative error of 1 - e <= 1e-8 over kappa in [1e-8, 100], both
-    /// rules, with a wide margin (measured 2.8e-12 and 9.0e-12: `restitution bench`'s candidates;
-    /// 1e-10 also passes, with a margin of only 3.4; 1e-12 costs 23% more for accuracy nobody asked
-    /// for). Checked in tests/viscoelastic.rs against the mpmath values.
-    pub const DEFAULT: OdeSettings = OdeSettings {
-        integrator: Integrator::Dop853,
-        rtol: 1e-11,
-        atol: 1e-11,
-        max_steps: 200_000,
-        stiffness_check: false,
-    };
-
-    /// The tightest setting, used to generate the master curve.
-    pub const REFERENCE: OdeSettings = OdeSettings {
-        integrator: Integrator::Dop853,
-        rtol: 1e-15,
-        atol: 1e-15,
-        max_steps: 2_000_000,
-        stiffness_check: false,
-    };
-
-    pub fn with_integrator(integrator: Integrator, tol: f64) -> Self {
-        OdeSettings {
-            integrator,
-            rtol: tol,
-            atol: tol,
-            ..Self::DEFAULT
-        }
-    }
-}
-
-impl Default for OdeSettings {
-    fn default() -> Self {
-        Self::DEFAULT
-    }
-}
-
-/// The outcome of one dimensionless collision (all quantities in the master-curve units:
-/// lengths in L = V T, times in T = k^(-2/5) V^(-1/5), forces in m_red L / T^2).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Rebound {
-    pub e: f64,
-    /// 1 - e with its own relative accuracy (not computed as 1 - e when e is close to 1).
-    pub one_minus_e: f64,
-    pub tau_contact: f64,
-    pub x_max: f64,
-    pub force_max: f64,
-    /// Overlap at the end of contact (0 for the overlap rule).
-    pub x_end: f64,
-    pub rhs_evals: u64,
-    pub steps: u64,
-}
-
-// Switch from r to t once the loading speed has dropped to this fraction of V: p is then far
-// enough from 0 that the r-formulation stays smooth, and x far enough from 0 for the t-one.
-const P_SWITCH: f64 = 0.5;
-// x never exceeds the undamped maximum (5/4)^(2/5) = 1.0933, so r never exceeds 1.0456.
-const R_LIMIT: f64 = 1.05;
-// Keeps the r-formulation finite if a trial stage lands on p = 0 (the step is then rejected).
-const P_FLOOR: f64 = 1e-200;
-const SLOPE_CAP: f64 = 1e150;
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Stage {
-    Loading,
-    Turning,
-    Unloading,
-    /// Plain integration between two points, for event refinement.
-    Probe(Var),
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Var {
-    Root,
-    Time,
-}
-
-impl Stage {
-    fn var(self) -> Var {
-        match self {
-            Stage::Loading | Stage::Unloading => Var::Root,
-            Stage::Turning => Var::Time,
-            Stage::Probe(v) => v,
-        }
-    }
-}
-
-/// (x, p) from the state of a phase: in r the state is (p, t, J), in t it is (x, p, J).
-fn x_p(var: Var, s: f64, y: &State) -> (f64, f64) {
-    match var {
-        Var::Root => (s * s, y[0]),
-        Var::Time => (y[0], y[1]),
-    }
-}
-
-fn time_of(var: Var, s: f64, y: &State) -> f64 {
-    match var {
-        Var::Root => y[1],
-        Var::Time => s,
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Event {
-    /// p = 0: maximum overlap.
-    Turning = 0,
-    /// dF/dt = 0: maximum force.
-    ForceMax = 1,
-    /// x + kappa p = 0: the force-rule end.
-    ForceZero = 2,
-}
-
-const EVENTS: [Event; 3] = [Event::Turning, Event::ForceMax, Event::ForceZero];
-
-/// Event functions of (x, p); each crosses from > 0 to <= 0 once per contact.
-fn event_value(ev: Event, kappa: f64, x: f64, p: f64) -> f64 {
-    match ev {
-        Event::Turning => p,
-        // 2 x^(1/2) dF/dt with F = x^(1/2) (x + kappa p) and p' = -x^(1/2) (x + kappa p).
-        Event::ForceMax => {
-            p * (3.0 * x + kappa * p) - 2.0 * kappa * x * x.max(0.0).sqrt() * (x + kappa * p)
-        }
-        Event::ForceZero => x + kappa * p,
-    }
-}
-
-fn force(kappa: f64, x: f64, p: f64) -> f64 {
-    x.max(0.0).sqrt() * (x + kappa * p)
-}
-
-#[derive(Debug, Clone, Copy)]
-struct Bracket {
-    s0: f64,
-    y0: State,
-    s1: f64,
-    y1: State,
-}
-
-/// One phase of the integration, seen by the solver through `&mut Phase` so that the caller can
-/// read back what `solout` recorded.
-struct Phase {
-    kappa: f64,
-    stage: Stage,
-    rule: ContactEnd,
-    /// Turning stage stops once p < 0 and x <= this.
-    x_switch: f64,
-    prev: (f64, State),
-    brackets: [Option<Bracket>; 3],
-    stopped: bool,
-    steps: u64,
-}
-
-impl Phase {
-    fn new(kappa: f64, stage: Stage, rule: ContactEnd, s0: f64, y0: State) -> Self {
-        Phase {
-            kappa,
-            stage,
-            rule,
-            x_switch: 0.0,
-            prev: (s0, y0),
-            brackets: [None; 3],
-            stopped: false,
-            steps: 0,
-        }
-    }
-
-    /// Called at every accepted step; returns true to stop the phase.
-    fn accept(&mut self, s: f64, y: State) -> bool {
-        self.steps += 1;
-        if let Stage::Probe(_) = self.stage {
-            return false;
-        }
-        let var = self.stage.var();
-        let (x0, p0) = x_p(var, self.prev.0, &self.prev.1);
-        let (x1, p1) = x_p(var, s, &y);
-        for ev in EVENTS {
-            let slot = &mut self.brackets[ev as usize];
-            if slot.is_none()
-                && event_value(ev, self.kappa, x0, p0) > 0.0
-                && event_value(ev, self.kappa, x1, p1) <= 0.0
-            {
-                *slot = Some(Bracket {
-                    s0: self.prev.0,
-                    y0: self.prev.1,
-                    s1: s,
-                    y1: y,
-                });
-            }
-        }
-        self.prev = (s, y);
-        let force_end =
-            self.rule == ContactEnd::Force && self.brackets[Event::ForceZero as usize].is_some();
-        self.stopped = match self.stage {
-            Stage::Loading => p1 <= P_SWITCH,
-            Stage::Turning => force_end || (p1 < 0.0 && x1 <= self.x_switch),
-            Stage::Unloading => force_end,
-            Stage::Probe(_) => false,
-        };
-        self.stopped
-    }
-}
-
-fn rhs(kappa: f64, var: Var, y: &State, dy: &mut State) {
-    match var {
-        Var::Root => {
-            let r = y[3];
-            let p = if y[0].abs() < P_FLOOR {
-                P_FLOOR.copysign(y[0])
-            } else {
-                y[0]
-            };
-            let r2 = r * r;
-            dy[0] = (-2.0 * r2 * (r2 + kappa * p) / p).clamp(-SLOPE_CAP, SLOPE_CAP);
-            dy[1] = (2.0 * r / p).clamp(-SLOPE_CAP, SLOPE_CAP);
-            dy[2] = 2.0 * r2 * p;
-            dy[3] = 1.0;
-        }
-        Var::Time => {
-            // Runge-Kutta stages may step past x = 0: clamp before the square root.
-            let x = y[0].max(0.0);
-            let p = y[1];
-            let sx = x.sqrt();
-            dy[0] = p;
-            dy[1] = -sx * (x + kappa * p);
-            dy[2] = sx * p * p;
-            dy[3] = 1.0;
-        }
-    }
-}
-
-impl System<f64, State> for &mut Phase {
-    fn system(&self, _s: f64, y: &State, dy: &mut State) {
-        rhs(self.kappa, self.stage.var(), y, dy);
-    }
-
-    fn solout(&mut self, s: f64, y: &State, _dy: &State) -> bool {
-        self.accept(s, *y)
-    }
-}
-
-fn integration_error(settings: &OdeSettings, kappa: f64, e: IntegrationError) -> Error {
-    Error::Integration {
-        method: settings.integrator.name(),
-        kappa,
-        reason: e.to_string(),
-    }
-}
-
-/// Integrates `phase` from (s0, y0) towards s1 until its `accept` stops it or s1 is reached.
-/// Returns the last accepted point and the right-hand-side evaluations spent.
-fn integrate(
-    phase: &mut Phase,
-    s0: f64,
-    y0: State,
-    s1: f64,
-    settings: &OdeSettings,
-) -> Result<(f64, State, u64)> {
-    let kappa = phase.kappa;
-    let n_stiff = if settings.stiffness_check {
-        1000
-    } else {
-        u32::MAX
-    };
-    let h_max = (s1 - s0).abs();
-    // Every phase variable is O(1) over a contact, so a first step of 0.05 (or the whole span of a
-    // short refinement) is safe; the solver's own first guess starts near 1e-6 at r = 0, where the
-    // right side vanishes, and wastes steps growing from there.
-    let h0 = (s1 - s0).signum() * h_max.min(0.05);
-    macro_rules! adaptive {
-        ($solver:ident, $beta:expr) => {{
-            let mut solver = $solver::from_param(
-                &mut *phase,
-                s0,
-                s1,
-                0.0,
-                y0,
-                settings.rtol,
-                settings.atol,
-                0.9,
-                $beta,
-                0.333,
-                6.0,
-                h_max,
-                h0,
-                settings.max_steps,
-                n_stiff,
-                OutputType::Sparse,
-            );
-            let stats = solver
-                .integrate()
-                .map_err(|e| integration_error(settings, kappa, e))?;
-            let s = *solver
-                .x_out()
-                .last()
-                .expect("solver output holds the start");
-            let y = *solver
-                .y_out()
-                .last()
-                .expect("solver output holds the start");
-            Ok((s, y, stats.num_eval as u64))
-        }};
-    }
-    match settings.integrator {
-        // Hairer's recommended PI-controller betas: 0 for DOP853, 0.04 for DOPRI5.
-        Integrator::Dop853 => adaptive!(Dop853, 0.0),
-        Integrator::Dopri5 => adaptive!(Dopri5, 0.04),
-        Integrator::Rk4 { h } => rk4(phase, s0, y0, s1, h, settings),
-    }
-}
-
-/// Classical RK4 at fixed step: ceil(|s1 - s0|/h) equal steps that land exactly on s1.
-fn rk4(
-    phase: &mut Phase,
-    s0: f64,
-    y0: State,
-    s1: f64,
-    h: f64,
-    settings: &OdeSettings,
-) -> Result<(f64, State, u64)> {
-    let kappa = phase.kappa;
-    let var = phase.stage.var();
-    let span = s1 - s0;
-    let n = (span.abs() / h).ceil().max(1.0);
-    let hh = span / n;
-    let (mut s, mut y) = (s0, y0);
-    let (mut k1, mut k2, mut k3, mut k4) = (
-        State::zeros(),
-        State::zeros(),
-        State::zeros(),
-        State::zeros(),
-    );
-    let mut evals = 0u64;
-    let mut i = 0.0;
-    while i < n {
-        if phase.steps >= settings.max_steps as u64 {
-            return Err(Error::Integration {
-                method: "rk4",
-                kappa,
-                reason: format!(
-                    "stopped at {s}: needs more than {} steps",
-                    settings.max_steps
-                ),
-            });
-        }
-        rhs(kappa, var, &y, &mut k1);
-        rhs(kappa, var, &(y + k1 * (0.5 * hh)), &mut k2);
-        rhs(kappa, var, &(y + k2 * (0.5 * hh)), &mut k3);
-        rhs(kappa, var, &(y + k3 * hh), &mut k4);
-        evals += 4;
-        y += (k1 + k2 * 2.0 + k3 * 2.0 + k4) * (hh / 6.0);
-        i += 1.0;
-        s = if i < n { s0 + i * hh } else { s1 };
-        if !y.iter().all(|v| v.is_finite()) {
-            return Err(Error::Integration {
-                method: "rk4",
-                kappa,
-                reason: format!("non-finite state at {s}: step {h} too large"),
-            });
-        }
-        if phase.accept(s, y) {
-            break;
-        }
-    }
-    Ok((s, y, evals))
-}
-
-/// Root of the event function on a bracket, by safeguarded Newton on re-integrations from the
-/// bracket's left end: the event's derivative along the solution comes from the right side, so
-/// each step costs one short integration and converges quadratically (plain regula falsi needed
-/// ~30 steps for the force-rule end at small kappa, where g = r^2 + kappa p is convex). Steps
-/// that would leave the bracket fall back to Illinois regula falsi (Dowell & Jarratt 1971), and
-/// the force maximum, whose derivative is not at hand, uses Illinois throughout.
-/// Returns the state at the root and the evaluations spent.
-fn locate(
-    kappa: f64,
-    var: Var,
-    ev: Event,
-    b: &Bracket,
-    settings: &OdeSettings,
-) -> Result<(f64, State, u64)> {
-    let g = |s: f64, y: &State| {
-        let (x, p) = x_p(var, s, y);
-        event_value(ev, kappa, x, p)
-    };
-    // dg/ds along the solution, where the event's formula makes it cheap.
-    let slope = |s: f64, y: &State| -> Option<f64> {
-        let mut dy = State::zeros();
-        rhs(kappa, var, y, &mut dy);
-        let (dx, dp) = match var {
-            Var::Root => (2.0 * s, dy[0]),
-            Var::Time => (dy[0], dy[1]),
-        };
-        match ev {
-            Event::Turning => Some(dp),
-            Event::ForceZero => Some(dx + kappa * dp),
-            Event::ForceMax => None,
-        }
-    };
-    let (mut a, mut fa) = (b.s0, g(b.s0, &b.y0));
-    let (mut c, mut fc) = (b.s1, g(b.s1, &b.y1));
-    let mut best = if fa.abs() < fc.abs() {
-        (b.s0, b.y0, fa)
-    } else {
-        (b.s1, b.y1, fc)
-    };
-    let mut evals = 0;
-    let mut side = 0i8;
-    for _ in 0..100 {
-        if best.2 == 0.0 || (c - a).abs() <= 4.0 * f64::EPSILON * c.abs().max(a.abs()).max(1e-300) {
-            break;
-        }
-        let inside = |s: f64| s.is_finite() && (s - a) * (s - c) < 0.0;
-        let newton = slope(best.0, &best.1).map(|d| best.0 - best.2 / d);
-        let s = match newton {
-            Some(s) if inside(s) => s,
-            _ => {
-                let s = (a * fc - c * fa) / (fc - fa);
-                if inside(s) { s } else { 0.5 * (a + c) }
-            }
-        };
-        // Converged when the next point is the current one to rounding (and integrating over a
-        // span of rounding size would be a step-size underflow).
-        if (s - best.0).abs() <= 16.0 * f64::EPSILON * s.abs().max(best.0.abs()) {
-            break;
-        }
-        // Always from the bracket's left end, so that every probe samples one and the same
-        // trajectory (probes chained from the last point drift apart at loose tolerances, and
-        // the bracket logic then locks onto a spurious sign change).
-        let mut probe = Phase::new(kappa, Stage::Probe(var), ContactEnd::Overlap, b.s0, b.y0);
-        let (_, y, n) = integrate(&mut probe, b.s0, b.y0, s, settings)?;
-        evals += n;
-        let fs = g(s, &y);
-        best = (s, y, fs);
-        if fs > 0.0 {
-            a = s;
-            fa = fs;
-            if side == -1 {
-                fc *= 0.5;
-            }
-            side = -1;
-        } else {
-            c = s;
-            fc = fs;
-            if side == 1 {
-                fa *= 0.5;
-            }
-            side = 1;
-        }
-    }
-    Ok((best.0, best.1, evals))
-}
-
-/// e and the other collision figures for dimensionless damping `kappa` (PHYSICS.md §2).
-pub fn rebound(kappa: f64, rule: ContactEnd, settings: &OdeSettings) -> Result<Rebound> {
-    solve(kappa, rule, settings, true)
-}
-
-/// e alone by the ODE: as [`rebound`] but without locating the overlap and force maxima
-/// (about half the right-hand-side evaluations).
-pub fn restitution_ode(
-    kappa: f64,
-    rule: ContactEnd,
-    settings: &OdeSettings,
-) -> Result<Restitution> {
-    let r = solve(kappa, rule, settings, false)?;
-    Ok(Restitution {
-        e: r.e,
-        one_minus_e: r.one_minus_e,
-        rhs_evals: r.rhs_evals,
-    })
-}
-
-fn solve(kappa: f64, rule: ContactEnd, settings: &OdeSettings, extrema: bool) -> Result<Rebound> {
-    non_negative("dimensionless damping kappa", kappa)?;
-    let mut evals = 0u64;
-    let mut steps = 0u64;
-    let mut x_max = f64::NAN;
-    let mut force_max = f64::NAN;
-    let mut end: Option<(Var, f64, State)> = None;
-
-    let mut note_events = |phase: &Phase, evals: &mut u64| -> Result<Option<(f64, State)>> {
-        let var = phase.stage.var();
-        if !extrema {
-            // Only the force-rule end below.
-        } else if let Some(b) = &phase.brackets[Event::Turning as usize] {
-            let (s, y, n) = locate(kappa, var, Event::Turning, b, settings)?;
-            *evals += n;
-            x_max = x_p(var, s, &y).0;
-        }
-        if let (true, Some(b)) = (extrema, &phase.brackets[Event::ForceMax as usize]) {
-            let (s, y, n) = locate(kappa, var, Event::ForceMax, b, settings)?;
-            *evals += n;
-            let (x, p) = x_p(var, s, &y);
-            force_max = force(kappa, x, p);
-        }
-        if let (ContactEnd::Force, Some(b)) = (rule, &phase.brackets[Event::ForceZero as usize]) {
-            let (s, y, n) = locate(kappa, var, Event::ForceZero, b, settings)?;
-            *evals += n;
-            return Ok(Some((s, y)));
-        }
-        Ok(None)
-    };
-
-    // Loading, in r from 0.
-    let y0 = State::new(1.0, 0.0, 0.0, 0.0);
-    let mut a = Phase::new(kappa, Stage::Loading, rule, 0.0, y0);
-    let (r_a, y_a, n) = integrate(&mut a, 0.0, y0, R_LIMIT, settings)?;
-    evals += n;
-    steps += a.steps;
-    if !a.stopped {
-        return Err(Error::Integration {
-            method: settings.integrator.name(),
-            kappa,
-            reason: "loading phase did not slow down as it must".into(),
-        });
-    }
-    note_events(&a, &mut evals)?;
-
-    // Around the turning point, in t.
-    let x_a = r_a * r_a;
-    let t_a = y_a[1];
-    let yb0 = State::new(x_a, y_a[0], y_a[2], t_a);
-    let t_limit = t_a + 100.0 * (1.0 + kappa);
-    let mut b = Phase::new(kappa, Stage::Turning, rule, t_a, yb0);
-    b.x_switch = x_a;
-    let (t_b, y_b, n) = integrate(&mut b, t_a, yb0, t_limit, settings)?;
-    evals += n;
-    steps += b.steps;
-    if !b.stopped {
-        return Err(Error::Integration {
-            method: settings.integrator.name(),
-            kappa,
-            reason: format!("no rebound within t = {t_limit} (dimensionless)"),
-        });
-    }
-    if let Some((s, y)) = note_events(&b, &mut evals)? {
-        end = Some((Var::Time, s, y));
-    }
-
-    if end.is_none() {
-        // Unloading, in r down to 0 (the overlap-rule end).
-        let r_c = y_b[0].max(0.0).sqrt();
-        let yc0 = State::new(y_b[1], t_b, y_b[2], r_c);
-        let mut c = Phase::new(kappa, Stage::Unloading, rule, r_c, yc0);
-        let (r_end, y_end, n) = integrate(&mut c, r_c, yc0, 0.0, settings)?;
-        evals += n;
-        steps += c.steps;
-        end = match note_events(&c, &mut evals)? {
-            Some((s, y)) => Some((Var::Root, s, y)),
-            None if rule == ContactEnd::Overlap || kappa == 0.0 => Some((Var::Root, r_end, y_end)),
-            None => {
-                return Err(Error::Integration {
-                    method: settings.integrator.name(),
-                    kappa,
-                    reason: "force never returned to zero before separation".into(),
-                });
-            }
-        };
-    }
-
-    let (var, s, y) = end.expect("every path sets the end of contact");
-    let (x_end, p_end) = x_p(var, s, &y);
-    // The bodies separate at the end of contact, so p_end < 0 always (overlap rule: p = -e; force
-    // rule: p = -x/kappa). p_end >= 0 means the integration went unstable in the slow unloading
-    // tail (fixed-step RK4, or loose tolerances at large kappa), and e from the energy balance
-    // below would be a wrong number near 0.5 (found by the bench's stability probe).
-    if p_end.is_nan() || p_end >= 0.0 {
-        return Err(Error::Integration {
-            method: settings.integrator.name(),
-            kappa,
-            reason: format!(
-                "unphysical result: not separating at the end of contact (p = {p_end})"
-            ),
-        });
-    }
-    let x_end = if var == Var::Root && rule == ContactEnd::Overlap {
-        0.0
-    } else {
-        x_end
-    };
-    let j = y[2];
-    // Energy balance: p_end^2/2 + (2/5) x_end^(5/2) = 1/2 - kappa J.
-    let one_minus_e2 = 2.0 * kappa * j + 0.8 * x_end.powf(2.5);
-    // A trajectory that dissipated more than the impact energy, or whose final speed disagrees
-    // grossly with the energy it kept, is not a solution (coarse fixed-step RK4 at kappa ~ 10
-    // returned e = 0.02-0.23 against 1e-6 this way; found by the bench's probe). Accurate runs
-    // agree to about the tolerance; 1e-6 and 1e-3 leave room for deliberately coarse settings.
-    let e2_energy = 1.0 - one_minus_e2;
-    if e2_energy < -1e-6 || (e2_energy > 0.25 && (e2_energy.sqrt() + p_end).abs() > 1e-3) {
-        return Err(Error::Integration {
-            method: settings.integrator.name(),
-            kappa,
-            reason: format!(
-                "unphysical result: energy balance violated (e from the energy {}, from the speed {})",
-                e2_energy.max(0.0).sqrt(),
-                -p_end
-            ),
-        });
-    }
-    let e_energy = (1.0 - one_minus_e2).max(0.0).sqrt();
-    let (e, one_minus_e) = if e_energy > 0.5 {
-        (e_energy, one_minus_e2 / (1.0 + e_energy))
-    } else {
-        (-p_end, 1.0 + p_end)
-    };
-    if !(e.is_finite() && e > 0.0 && e <= 1.0) {
-        return Err(Error::Integration {
-            method: settings.integrator.name(),
-            kappa,
-            reason: format!("unphysical result e = {e}"),
-        });
-    }
-    Ok(Rebound {
-        e,
-        one_minus_e,
-        tau_contact: time_of(var, s, &y),
-        x_max,
-        force_max,
-        x_end,
-        rhs_evals: evals,
-        steps,
-    })
 }
 
 /// e and 1 - e from any of the evaluation methods, with the work it took.
@@ -762,68 +99,26 @@ pub struct Restitution {
 /// How e(kappa) is evaluated.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum VmMethod {
-    /// The master-curve table inside its range, the default ODE outside it.
+    /// The master curve: table and large-kappa laws, every finite kappa >= 0.
     #[default]
     Master,
     /// The ODE at the given setting, for every point.
     Ode(OdeSettings),
 }
 
-/// e(kappa) by the chosen method (the master curve falls back to the default ODE above
-/// [`master::KAPPA_MAX`]).
+/// e(kappa) by the chosen method. [`VmMethod::Master`] covers every finite kappa >= 0 (table and
+/// large-kappa laws, [`master::restitution_master`]); NaN, infinite or negative kappa is an error.
 pub fn restitution(kappa: f64, rule: ContactEnd, method: &VmMethod) -> Result<Restitution> {
     match method {
-        VmMethod::Master => match master::restitution_master(kappa, rule) {
-            Some(r) => Ok(r),
-            None => restitution_ode(kappa, rule, &OdeSettings::DEFAULT),
-        },
+        VmMethod::Master => {
+            crate::error::non_negative("dimensionless damping kappa", kappa)?;
+            master::restitution_master(kappa, rule).ok_or(crate::error::Error::InvalidParameter {
+                name: "dimensionless damping kappa",
+                value: kappa,
+                expected: "a finite number >= 0",
+            })
+        }
         VmMethod::Ode(settings) => restitution_ode(kappa, rule, settings),
-    }
-}
-
-/// A viscoelastic contact with damping eta (kg s^-1 m^-1), in SI units.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Viscoelastic {
-    pub contact: Contact,
-    pub eta: f64,
-}
-
-/// A dimensional collision of the viscoelastic model.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Impact {
-    pub kappa: f64,
-    pub e: f64,
-    pub contact_time_s: f64,
-    pub max_overlap_m: f64,
-    pub max_force_n: f64,
-    pub dimensionless: Rebound,
-}
-
-impl Viscoelastic {
-    pub fn new(contact: Contact, eta: f64) -> Result<Self> {
-        non_negative("damping eta (kg/(s m))", eta)?;
-        Ok(Viscoelastic { contact, eta })
-    }
-
-    pub fn kappa(&self, v_m_s: f64) -> f64 {
-        self.contact.kappa(self.eta, v_m_s)
-    }
-
-    /// Integrates one collision at normal impact speed `v_m_s` and converts back to SI units.
-    pub fn impact(&self, v_m_s: f64, rule: ContactEnd, settings: &OdeSettings) -> Result<Impact> {
-        crate::error::positive("impact speed (m/s)", v_m_s)?;
-        let kappa = self.kappa(v_m_s);
-        let r = rebound(kappa, rule, settings)?;
-        let t = self.contact.time_scale_s(v_m_s);
-        let l = v_m_s * t;
-        Ok(Impact {
-            kappa,
-            e: r.e,
-            contact_time_s: r.tau_contact * t,
-            max_overlap_m: r.x_max * l,
-            max_force_n: r.force_max * self.contact.m_red_kg * l / (t * t),
-            dimensionless: r,
-        })
     }
 }
 
@@ -832,58 +127,15 @@ mod tests {
     use super::*;
 
     #[test]
-    fn hertz_limit_is_elastic() {
-        // kappa = 0: e = 1 exactly, and the Hertz contact time and maximum overlap are known in
-        // closed form: x_max = (5/4)^(2/5), tau = 3.2180654597190430845 (PHYSICS.md §2). The
-        // trajectory is accurate to about the tolerance, so these get 10 tol.
-        let tol = 10.0 * OdeSettings::DEFAULT.rtol;
-        for rule in ContactEnd::ALL {
-            let r = rebound(0.0, rule, &OdeSettings::DEFAULT).unwrap();
-            assert!((r.e - 1.0).abs() < 1e-14, "{rule}: {r:?}");
-            assert!((r.tau_contact - 3.2180654597190430845).abs() < tol, "{r:?}");
-            assert!((r.x_max - 1.25f64.powf(0.4)).abs() < tol, "{r:?}");
-            assert!((r.force_max - 1.25f64.powf(0.6)).abs() < tol, "{r:?}");
+    fn rule_names_round_trip() {
+        for r in ContactEnd::ALL {
+            assert_eq!(r.name().parse::<ContactEnd>().unwrap(), r);
+            assert_eq!(r.to_string(), r.name());
         }
-    }
-
-    #[test]
-    fn small_kappa_slope_is_ramirez_c1() {
-        // 1 - e = C1 kappa - C2 kappa^2 + O(kappa^3) (Ramirez et al. 1999), overlap rule.
-        let c1 = 1.15344885809528879913;
-        let c2 = 0.6 * c1 * c1;
-        for kappa in [1e-8, 1e-6, 1e-4] {
-            let r = rebound(kappa, ContactEnd::Overlap, &OdeSettings::DEFAULT).unwrap();
-            let series = c1 * kappa - c2 * kappa * kappa;
-            // Truncation O(kappa^3) plus the 1e-8 relative accuracy bar.
-            let tol = 1e-8 * series + 2.0 * kappa.powi(3);
-            assert!(
-                (r.one_minus_e - series).abs() < tol,
-                "{kappa}: {r:?} vs {series}"
-            );
-        }
-    }
-
-    #[test]
-    fn force_rule_ends_no_later_and_bounces_more() {
-        for kappa in [1e-3, 0.1, 1.0, 10.0] {
-            let o = rebound(kappa, ContactEnd::Overlap, &OdeSettings::DEFAULT).unwrap();
-            let f = rebound(kappa, ContactEnd::Force, &OdeSettings::DEFAULT).unwrap();
-            assert!(
-                f.e >= o.e && f.tau_contact < o.tau_contact,
-                "{kappa}: {o:?} {f:?}"
-            );
-            assert!(f.x_end > 0.0);
-            assert!(
-                (f.x_end + kappa * -f.e).abs() < 1e-9,
-                "force zero at the end: {f:?}"
-            );
-        }
-    }
-
-    #[test]
-    fn rejects_bad_kappa() {
-        for k in [-1.0, f64::NAN, f64::INFINITY] {
-            assert!(rebound(k, ContactEnd::Overlap, &OdeSettings::DEFAULT).is_err());
-        }
+        let err = "elastic".parse::<ContactEnd>().unwrap_err();
+        assert_eq!(
+            err,
+            "'elastic' is not a contact-end rule: expected overlap or force"
+        );
     }
 }

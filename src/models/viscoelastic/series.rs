@@ -334,10 +334,10 @@ pub fn restitution_checked(
     let r = restitution_approx(kappa, rule, approx)?;
     match error_bound(kappa, rule, approx) {
         Some(b) if b <= tol * r.one_minus_e.clamp(0.0, 1.0) || (kappa == 0.0 && b <= tol) => Ok(r),
-        _ => Err(Error::InvalidParameter {
-            name: "dimensionless damping kappa",
-            value: kappa,
-            expected: "a kappa where the approximation's error bound meets the requested accuracy (series::error_bound)",
+        _ => Err(Error::BeyondErrorBound {
+            approximation: approx.name(),
+            kappa,
+            tol,
         }),
     }
 }
