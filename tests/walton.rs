@@ -4,13 +4,12 @@ use nalgebra::Vector3;
 use proptest::prelude::*;
 use restitution::contact::{Material, Sphere};
 use restitution::data::Table;
-use restitution::fit::walton::{
-    CollisionRecord, FitOptions, SyntheticSpec, Weights, fit, measure_records, read_collisions,
-    synthetic_collisions, write_collisions,
-};
+use restitution::data::walton::{measure_records, read_collisions, write_collisions};
+use restitution::fit::walton::{CollisionRecord, FitOptions, Weights, fit};
 use restitution::models::walton::{
     Body, ContactKind, K_HOMOGENEOUS, State, Target, WaltonParams, collide, measure,
 };
+use restitution::synthetic::{SyntheticSpec, synthetic_collisions};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 

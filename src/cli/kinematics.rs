@@ -20,9 +20,10 @@
 
 use super::{CliResult, Format, MaterialArgs};
 use restitution::data::tracks::read_tracks;
+use restitution::data::walton::write_collisions;
 use restitution::data::{fmt_num, write_all_atomic};
 use restitution::experiment::Camera;
-use restitution::fit::walton::{CollisionRecord, write_collisions};
+use restitution::fit::walton::CollisionRecord;
 use restitution::kinematics::{
     Eq8Inputs, FitKind, G_STANDARD_M_S2, Measurement, analyse, measure_collision, split_at_contact,
 };

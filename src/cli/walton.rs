@@ -25,10 +25,9 @@
 //! and `fig6.svg`, all or none.
 
 use super::{CliResult, Format, MaterialArgs};
+use restitution::data::walton::{measure_records, read_collisions};
 use restitution::data::{Table, fmt_num, write_all_atomic};
-use restitution::fit::walton::{
-    self as wfit, Bound, Estimate, FitOptions, WaltonFit, Weights, read_collisions,
-};
+use restitution::fit::walton::{self as wfit, Bound, Estimate, FitOptions, WaltonFit, Weights};
 use restitution::models::walton::{K_HOMOGENEOUS, Target};
 use restitution::plot::walton::{Fig6Fit, Fig6Point, fig6_svg};
 use serde_json::{Value, json};
@@ -129,7 +128,7 @@ fn run_fit(a: FitArgs) -> CliResult {
     for w in &warnings {
         eprintln!("restitution: warning: {w}");
     }
-    let measured = wfit::measure_records(&table.path, &records).map_err(|e| e.to_string())?;
+    let measured = measure_records(&table.path, &records).map_err(|e| e.to_string())?;
     let options = FitOptions {
         inertia_k: a.inertia_k,
         weights: match a.weights {
