@@ -21,7 +21,7 @@
 use super::{CliResult, Format, MaterialArgs};
 use restitution::data::tracks::read_tracks;
 use restitution::data::walton::write_collisions;
-use restitution::data::{fmt_num, write_all_atomic};
+use restitution::data::{CsvOut, fmt_num, write_all_atomic};
 use restitution::experiment::Camera;
 use restitution::fit::walton::CollisionRecord;
 use restitution::kinematics::{
@@ -262,7 +262,7 @@ pub fn run(args: Args) -> CliResult {
             return Err(skipped.swap_remove(0));
         }
         for s in &skipped {
-            eprintln!("restitution: warning: skipped {s}");
+            super::warn(format_args!("skipped {s}"));
         }
     }
     let fallbacks: Vec<&str> = rows
@@ -271,59 +271,66 @@ pub fn run(args: Args) -> CliResult {
         .map(|r| r.id.as_str())
         .collect();
     if !fallbacks.is_empty() {
-        eprintln!(
-            "restitution: warning: {} collision(s) never reach contact distance on the pre-collision fits (noise); their time is where pre and post fits meet: {}",
+        super::warn(format_args!(
+            "{} collision(s) never reach contact distance on the pre-collision fits (noise); their time is where pre and post fits meet: {}",
             fallbacks.len(),
             fallbacks.join(", ")
-        );
+        ));
     }
-    let table_csv = {
-        let mut s = COLUMNS.join(",") + "\n";
-        for r in &rows {
-            s += &(r.cells().join(",") + "\n");
+    let comment = format!(
+        "made by restitution kinematics from {shown} ({})",
+        if args.fixed_gravity {
+            "fixed-gravity fits"
+        } else {
+            "free quadratic fits"
         }
-        s
+    );
+    let table_csv = |comment: Option<&str>| {
+        let mut out = CsvOut::new();
+        if let Some(c) = comment {
+            out.comment(c);
+        }
+        out.record(COLUMNS);
+        for r in &rows {
+            out.record(r.cells());
+        }
+        out.into_string()
     };
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
-        let mut fit_csv = String::from("d_mm,d2_mm,v_n_m_s,e,e_err\n");
+        let mut fit_csv = CsvOut::new();
+        fit_csv.comment(&comment);
+        fit_csv.record(["d_mm", "d2_mm", "v_n_m_s", "e", "e_err"]);
         for r in &rows {
-            fit_csv += &format!(
-                "{},{},{},{},{}\n",
+            fit_csv.record([
                 fmt_num(r.d1_mm),
                 fmt_num(r.d2_mm),
                 fmt_num(r.m.measured.v_n_m_s),
                 fmt_num(r.m.measured.e),
-                fmt_num(r.m.e_err)
-            );
+                fmt_num(r.m.e_err),
+            ]);
         }
-        let header = format!(
-            "# made by restitution kinematics from {shown} ({})\n",
-            if args.fixed_gravity {
-                "fixed-gravity fits"
-            } else {
-                "free quadratic fits"
-            }
-        );
+        let mut walton_csv = CsvOut::new();
+        walton_csv.comment(&comment);
         write_all_atomic(&[
             (
                 dir.join("kinematics.csv"),
-                (header.clone() + &table_csv).into_bytes(),
+                table_csv(Some(&comment)).into_bytes(),
             ),
             (
                 dir.join("fit_input.csv"),
-                (header.clone() + &fit_csv).into_bytes(),
+                fit_csv.into_string().into_bytes(),
             ),
             (
                 dir.join("walton_input.csv"),
-                (header + &write_collisions(&records)).into_bytes(),
+                (walton_csv.into_string() + &write_collisions(&records)).into_bytes(),
             ),
         ])
         .map_err(|e| format!("{}: cannot write: {e}", dir.display()))?;
     }
-    match args.format {
-        Format::Csv => print!("{table_csv}"),
+    let text = match args.format {
+        Format::Csv => table_csv(None),
         Format::Json => {
             let list: Vec<serde_json::Value> = rows
                 .iter()
@@ -345,14 +352,11 @@ pub fn run(args: Args) -> CliResult {
                     serde_json::Value::Object(map)
                 })
                 .collect();
-            println!(
-                "{}",
-                serde_json::to_string_pretty(&list).expect("serialisable")
-            );
+            serde_json::to_string_pretty(&list).expect("JSON values serialise") + "\n"
         }
         Format::Table => {
-            println!(
-                "{:>10} {:>7} {:>9} {:>8} {:>8} {:>8} {:>8} {:>7} {:>7} {:>5}/{:<5} time",
+            let mut s = format!(
+                "{:>10} {:>7} {:>9} {:>8} {:>8} {:>8} {:>8} {:>7} {:>7} {:>5}/{:<5} time\n",
                 "collision",
                 "v_n",
                 "e",
@@ -368,8 +372,8 @@ pub fn run(args: Args) -> CliResult {
             for r in &rows {
                 let me = &r.m.measured;
                 let dv = me.com_velocity_change_m_s.unwrap_or_default();
-                println!(
-                    "{:>10} {:>7.3} {:>9.4} {:>8.4} {:>8.4} {:>8} {:>8.3} {:>7.3} {:>7.3} {:>5}/{:<5} {}",
+                s += &format!(
+                    "{:>10} {:>7.3} {:>9.4} {:>8.4} {:>8.4} {:>8} {:>8.3} {:>7.3} {:>7.3} {:>5}/{:<5} {}\n",
                     r.id,
                     me.v_n_m_s,
                     me.e,
@@ -386,14 +390,15 @@ pub fn run(args: Args) -> CliResult {
                     r.m.kinematics.time_rule.name()
                 );
             }
-            println!(
-                "(speeds m/s; e_err from the fits' covariance with the position noise pooled over all collisions: {} m = {:.2} subpixels; e_eq8 from Eq. 8 with s = {} subpixels of {} m; dv: momentum check)",
+            s += &format!(
+                "(speeds m/s; e_err from the fits' covariance with the position noise pooled over all collisions: {} m = {:.2} subpixels; e_eq8 from Eq. 8 with s = {} subpixels of {} m; dv: momentum check)\n",
                 fmt_num(sigma),
                 sigma / subpixel_m,
                 fmt_num(args.s_subpixels),
                 fmt_num(subpixel_m)
             );
+            s
         }
-    }
-    Ok(())
+    };
+    super::emit(&text)
 }

@@ -20,7 +20,7 @@ use rand::SeedableRng;
 use rand::rngs::StdRng;
 use restitution::contact::Pair;
 use restitution::data::tracks::{CollisionTrack, write_tracks};
-use restitution::data::{fmt_num, write_all_atomic};
+use restitution::data::{CsvOut, fmt_num, write_all_atomic};
 use restitution::experiment::{Camera, ExperimentSpec, camera_study, simulate};
 use restitution::fit::models::{ModelKind, predict_e};
 use restitution::models::viscoelastic::{ContactEnd, VmMethod};
@@ -93,7 +93,6 @@ pub struct Args {
     spin_noise_rad_s: f64,
     /// Instead of tracks: a Monte Carlo of the measured e's bias and scatter against v_n for
     /// this camera and three better ones (camera_study.csv, camera_study.svg); faster cameras
-    /// film the same time window, in proportionally more frames; faster cameras
     /// film the same time window, in proportionally more frames
     #[arg(long = "camera-study")]
     camera_study: bool,
@@ -244,17 +243,34 @@ pub fn run(args: Args) -> CliResult {
             spins_rad_s: Some(s.spins_measured_rad_s),
         })
         .collect();
-    let mut truth = String::from(
-        "collision,v_n_m_s,e,beta,psi,contact,v1x_m_s,v1y_m_s,v2x_m_s,v2y_m_s,v1x_post_m_s,v1y_post_m_s,v2x_post_m_s,v2y_post_m_s,w1z_rad_s,w2z_rad_s,w1z_post_rad_s,w2z_post_rad_s\n",
-    );
+    let mut truth = CsvOut::new();
+    truth.record([
+        "collision",
+        "v_n_m_s",
+        "e",
+        "beta",
+        "psi",
+        "contact",
+        "v1x_m_s",
+        "v1y_m_s",
+        "v2x_m_s",
+        "v2y_m_s",
+        "v1x_post_m_s",
+        "v1y_post_m_s",
+        "v2x_post_m_s",
+        "v2y_post_m_s",
+        "w1z_rad_s",
+        "w2z_rad_s",
+        "w1z_post_rad_s",
+        "w2z_post_rad_s",
+    ]);
     for s in &sims {
         let (Target::Sphere(a), Target::Sphere(b)) = (&s.pre.target, &s.post.target) else {
             unreachable!("simulated pairs");
         };
         let (p1, q1) = (&s.pre.sphere, &s.post.sphere);
-        let cells: Vec<String> = [s.v_n_m_s, s.e, s.beta, s.psi]
-            .iter()
-            .map(|&x| fmt_num(x))
+        let cells: Vec<String> = std::iter::once(s.id.clone())
+            .chain([s.v_n_m_s, s.e, s.beta, s.psi].iter().map(|&x| fmt_num(x)))
             .chain(std::iter::once(s.kind.as_str().to_string()))
             .chain(
                 [
@@ -275,7 +291,7 @@ pub fn run(args: Args) -> CliResult {
                 .map(|&x| fmt_num(x)),
             )
             .collect();
-        truth += &format!("{},{}\n", s.id, cells.join(","));
+        truth.record(cells);
     }
     let meta = json!({
         "seed": args.seed,
@@ -302,7 +318,7 @@ pub fn run(args: Args) -> CliResult {
             args.out.join("tracks.csv"),
             write_tracks(&tracks).into_bytes(),
         ),
-        (args.out.join("truth.csv"), truth.into_bytes()),
+        (args.out.join("truth.csv"), truth.into_string().into_bytes()),
         (
             args.out.join("truth.json"),
             (serde_json::to_string_pretty(&meta).expect("serialisable") + "\n").into_bytes(),
@@ -310,14 +326,13 @@ pub fn run(args: Args) -> CliResult {
     ])
     .map_err(|e| format!("{}: cannot write: {e}", args.out.display()))?;
     let frames: usize = sims.iter().map(|s| s.frames.len()).sum();
-    println!(
-        "simulated {} collisions ({} frames, position noise {} m) -> {}/tracks.csv, truth.csv, truth.json",
+    super::emit(&format!(
+        "simulated {} collisions ({} frames, position noise {} m) -> {}/tracks.csv, truth.csv, truth.json\n",
         sims.len(),
         frames,
         fmt_num(camera.sigma_m()),
         args.out.display()
-    );
-    Ok(())
+    ))
 }
 
 /// The camera study: this camera, twice the frame rate, four times the pixels, and both better.
@@ -367,18 +382,26 @@ fn study(
     let speeds = [0.3, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0];
     let points = camera_study(spec, &cameras, &speeds, args.study_n, e_of, rng)
         .map_err(|e| e.to_string())?;
-    let mut csv = String::from("camera,fit,v_n_m_s,simulated,measured,bias,scatter\n");
+    let mut csv = CsvOut::new();
+    csv.record([
+        "camera",
+        "fit",
+        "v_n_m_s",
+        "simulated",
+        "measured",
+        "bias",
+        "scatter",
+    ]);
     for p in &points {
-        csv += &format!(
-            "{},{},{},{},{},{},{}\n",
-            p.camera,
-            p.fit,
+        csv.record([
+            p.camera.to_string(),
+            p.fit.to_string(),
             fmt_num(p.v_n_m_s),
-            p.simulated,
-            p.measured,
+            p.simulated.to_string(),
+            p.measured.to_string(),
             fmt_num(p.bias),
-            fmt_num(p.scatter)
-        );
+            fmt_num(p.scatter),
+        ]);
     }
     let title = format!(
         "Measured e against true e: {} mm {}, s = {} subpixels, {}-{} frames per phase at the base rate",
@@ -392,14 +415,16 @@ fn study(
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("{}: cannot create: {e}", args.out.display()))?;
     write_all_atomic(&[
-        (args.out.join("camera_study.csv"), csv.into_bytes()),
+        (
+            args.out.join("camera_study.csv"),
+            csv.into_string().into_bytes(),
+        ),
         (args.out.join("camera_study.svg"), svg.into_bytes()),
     ])
     .map_err(|e| format!("{}: cannot write: {e}", args.out.display()))?;
-    println!(
-        "camera study: {} points -> {}/camera_study.csv, camera_study.svg",
+    super::emit(&format!(
+        "camera study: {} points -> {}/camera_study.csv, camera_study.svg\n",
         points.len(),
         args.out.display()
-    );
-    Ok(())
+    ))
 }

@@ -25,6 +25,7 @@
 //! and `fig6.svg`, all or none.
 
 use super::{CliResult, Format, MaterialArgs};
+use restitution::data::CsvOut;
 use restitution::data::walton::{measure_records, read_collisions};
 use restitution::data::{Table, fmt_num, write_all_atomic};
 use restitution::fit::walton::{self as wfit, Bound, Estimate, FitOptions, WaltonFit, Weights};
@@ -126,7 +127,7 @@ fn run_fit(a: FitArgs) -> CliResult {
     let (records, warnings) =
         read_collisions(&table, &material, a.inertia_k).map_err(|e| e.to_string())?;
     for w in &warnings {
-        eprintln!("restitution: warning: {w}");
+        super::warn(w);
     }
     let measured = measure_records(&table.path, &records).map_err(|e| e.to_string())?;
     let options = FitOptions {
@@ -141,7 +142,7 @@ fn run_fit(a: FitArgs) -> CliResult {
     let fit =
         wfit::fit(&measured, &options).map_err(|e| format!("{}: cannot fit: {e}", table.path))?;
     if !fit.converged {
-        eprintln!("restitution: warning: {}: {}", table.path, fit.message);
+        super::warn(format_args!("{}: {}", table.path, fit.message));
     }
     let mut diameters_mm: Vec<f64> = Vec::new();
     let mut walls = 0;
@@ -201,8 +202,7 @@ fn run_fit(a: FitArgs) -> CliResult {
         write_all_atomic(&files)
             .map_err(|e| format!("--out {}: cannot write: {e}", dir.display()))?;
     }
-    print!("{text}");
-    Ok(())
+    super::emit(&text)
 }
 
 pub(crate) fn fig6_points(fit: &WaltonFit) -> Vec<Fig6Point> {
@@ -339,11 +339,19 @@ fn render_table(fit: &WaltonFit, ctx: &Context) -> String {
 }
 
 fn render_params_csv(fit: &WaltonFit) -> String {
-    let mut s = "parameter,value,stderr,ci95_low,ci95_high,bound\n".to_string();
+    let mut out = CsvOut::new();
+    out.record([
+        "parameter",
+        "value",
+        "stderr",
+        "ci95_low",
+        "ci95_high",
+        "bound",
+    ]);
+    let opt = |x: Option<f64>| x.map(fmt_num).unwrap_or_default();
     for (name, est) in param_rows(fit) {
-        let opt = |x: Option<f64>| x.map(fmt_num).unwrap_or_default();
-        s += &format!(
-            "{name},{},{},{},{},{}\n",
+        out.record([
+            name.to_string(),
             fmt_num(est.value),
             opt(est.stderr),
             opt(est.ci95.map(|c| c.0)),
@@ -352,32 +360,48 @@ fn render_params_csv(fit: &WaltonFit) -> String {
                 Some(Bound::Lower) => "lower",
                 None => "",
             }
-        );
+            .to_string(),
+        ]);
     }
-    s
+    out.into_string()
 }
 
 fn render_collisions_csv(fit: &WaltonFit, ctx: &Context) -> String {
-    let mut s =
-        "line,collision,e,beta,psi,v_n_m_s,v_s_m_s,impulse_ratio,class,residual\n".to_string();
+    let mut out = CsvOut::new();
+    out.record([
+        "line",
+        "collision",
+        "e",
+        "beta",
+        "psi",
+        "v_n_m_s",
+        "v_s_m_s",
+        "impulse_ratio",
+        "class",
+        "residual",
+    ]);
+    let opt = |x: Option<f64>| x.map(fmt_num).unwrap_or_default();
     for (i, c) in fit.collisions.iter().enumerate() {
         let m = &c.measured;
-        let opt = |x: Option<f64>| x.map(fmt_num).unwrap_or_default();
-        s += &format!(
-            "{},{},{},{},{},{},{},{},{},{}\n",
-            ctx.lines[i],
+        out.record([
+            ctx.lines[i].to_string(),
             ctx.ids[i].clone().unwrap_or_default(),
             fmt_num(m.e),
             opt(m.beta),
-            fmt_num(m.psi),
+            // Head-on: psi is infinite and the class says so.
+            if m.psi.is_finite() {
+                fmt_num(m.psi)
+            } else {
+                String::new()
+            },
             fmt_num(m.v_n_m_s),
             fmt_num(m.v_s_m_s),
             fmt_num(m.impulse_ratio),
-            class(c),
-            opt(c.residual)
-        );
+            class(c).to_string(),
+            opt(c.residual),
+        ]);
     }
-    s
+    out.into_string()
 }
 
 fn class(c: &wfit::Classified) -> &'static str {
