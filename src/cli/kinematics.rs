@@ -32,6 +32,7 @@ use std::path::PathBuf;
 
 /// Velocities, e, beta and psi from tracked sphere centres (Sec. III)
 #[derive(clap::Args, Debug)]
+#[command(allow_negative_numbers = true)]
 pub struct Args {
     /// Tracks CSV (collision, t_s, x1_m, y1_m, x2_m, y2_m, d1_mm, d2_mm [, phase, spins])
     #[arg(value_name = "TRACKS.csv")]
@@ -71,6 +72,9 @@ pub struct Args {
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
 }
+
+/// Most skipped collisions named one by one.
+const MAX_WARNINGS: usize = 20;
 
 const COLUMNS: [&str; 27] = [
     "collision",
@@ -145,7 +149,12 @@ impl Row {
             c.push(fmt_num(x));
         }
         c.push(me.beta.map(fmt_num).unwrap_or_default());
-        c.push(fmt_num(me.psi));
+        // Head-on (no tangential velocity): psi is infinite, left empty like beta.
+        c.push(if me.psi.is_finite() {
+            fmt_num(me.psi)
+        } else {
+            String::new()
+        });
         c.push(fmt_num(dv.x));
         c.push(fmt_num(dv.y));
         c.push(fmt_num(self.d1_mm));
@@ -191,7 +200,11 @@ pub fn run(args: Args) -> CliResult {
     // Two passes: the position noise is one camera's, so the residuals of all collisions are
     // pooled into one estimate (a 10-frame fit alone estimates it poorly), then every error uses it.
     let place = |t: &restitution::data::tracks::CollisionTrack| {
-        format!("{shown}:{}: collision '{}'", t.first_line, t.id)
+        format!(
+            "{shown}:{}: collision '{}'",
+            t.first_line,
+            restitution::data::shown(&t.id)
+        )
     };
     let mut splits = Vec::new();
     let (mut rss, mut dof) = (0.0, 0usize);
@@ -244,37 +257,63 @@ pub fn run(args: Args) -> CliResult {
                 continue;
             }
         };
-        records.push(CollisionRecord {
-            line: t.first_line,
-            id: Some(t.id.clone()),
-            pre: m.pre,
-            post: m.post,
-        });
-        rows.push(Row {
+        let row = Row {
             id: t.id.clone(),
             d1_mm: t.d1_m * 1e3,
             d2_mm: t.d2_m * 1e3,
             m,
+        };
+        // A number is right or it is an error: a collision whose numbers overflowed (absurd
+        // magnitudes in the tracks or flags) is unmeasurable, not printed as NaN.
+        if let Some((col, v)) = COLUMNS
+            .iter()
+            .zip(row.cells())
+            .find(|(c, v)| **c != "collision" && (v == "NaN" || v.ends_with("inf")))
+        {
+            skipped.push(format!(
+                "{}: {col} = {v} (the tracks or flags are out of range)",
+                place(t)
+            ));
+            continue;
+        }
+        records.push(CollisionRecord {
+            line: t.first_line,
+            id: Some(t.id.clone()),
+            pre: row.m.pre,
+            post: row.m.post,
         });
+        rows.push(row);
     }
     if !skipped.is_empty() {
         if args.strict || rows.is_empty() {
             return Err(skipped.swap_remove(0));
         }
-        for s in &skipped {
+        // One line each, up to a screenful; a file of 100 000 bad tracks gets a count.
+        for s in skipped.iter().take(MAX_WARNINGS) {
             super::warn(format_args!("skipped {s}"));
         }
+        if skipped.len() > MAX_WARNINGS {
+            super::warn(format_args!(
+                "skipped {} more collisions that cannot be measured",
+                skipped.len() - MAX_WARNINGS
+            ));
+        }
     }
-    let fallbacks: Vec<&str> = rows
+    let fallbacks: Vec<String> = rows
         .iter()
         .filter(|r| r.m.kinematics.time_rule != restitution::kinematics::TimeRule::ContactDistance)
-        .map(|r| r.id.as_str())
+        .map(|r| restitution::data::shown(&r.id))
         .collect();
     if !fallbacks.is_empty() {
         super::warn(format_args!(
             "{} collision(s) never reach contact distance on the pre-collision fits (noise); their time is where pre and post fits meet: {}",
             fallbacks.len(),
-            fallbacks.join(", ")
+            fallbacks[..fallbacks.len().min(MAX_WARNINGS)].join(", ")
+                + if fallbacks.len() > MAX_WARNINGS {
+                    ", ..."
+                } else {
+                    ""
+                }
         ));
     }
     let comment = format!(
@@ -373,7 +412,7 @@ pub fn run(args: Args) -> CliResult {
                 let me = &r.m.measured;
                 let dv = me.com_velocity_change_m_s.unwrap_or_default();
                 s += &format!(
-                    "{:>10} {:>7.3} {:>9.4} {:>8.4} {:>8.4} {:>8} {:>8.3} {:>7.3} {:>7.3} {:>5}/{:<5} {}\n",
+                    "{:>10} {:>7.3} {:>9.4} {:>8.4} {:>8.4} {:>8} {:>8} {:>7.3} {:>7.3} {:>5}/{:<5} {}\n",
                     r.id,
                     me.v_n_m_s,
                     me.e,
@@ -382,7 +421,11 @@ pub fn run(args: Args) -> CliResult {
                     me.beta
                         .map(|b| format!("{b:.3}"))
                         .unwrap_or_else(|| "-".into()),
-                    me.psi,
+                    if me.psi.is_finite() {
+                        format!("{:.3}", me.psi)
+                    } else {
+                        "-".into()
+                    },
                     dv.x,
                     dv.y,
                     r.m.kinematics.n_pre,

@@ -65,7 +65,29 @@ impl MaterialArgs {
             });
         }
         match (self.youngs_pa, self.poisson, self.density_kg_m3) {
-            (Some(y), Some(nu), Some(rho)) => Material::new(y, nu, rho).map_err(|e| e.to_string()),
+            (Some(y), Some(nu), Some(rho)) => {
+                for (flag, v, ok, expected) in [
+                    ("--youngs-pa", y, y.is_finite() && y > 0.0, "a modulus > 0 (Pa)"),
+                    (
+                        "--poisson",
+                        nu,
+                        nu.is_finite() && nu > -1.0 && nu < 0.5,
+                        "a number in (-1, 0.5)",
+                    ),
+                    (
+                        "--density-kg-m3",
+                        rho,
+                        rho.is_finite() && rho > 0.0,
+                        "a density > 0 (kg/m^3)",
+                    ),
+                ] {
+                    if !ok {
+                        return Err(format!("{flag} {v}: expected {expected}"));
+                    }
+                }
+                Material::new(y, nu, rho)
+                    .map_err(|e| format!("--youngs-pa, --poisson, --density-kg-m3: {e}"))
+            }
             _ => Err("a material is needed: --material NAME, or all of --youngs-pa, --poisson and --density-kg-m3".into()),
         }
     }

@@ -30,11 +30,12 @@ use std::path::PathBuf;
 
 /// A virtual experiment: simulated tracks of oblique collisions seen by a high-speed camera
 #[derive(clap::Args, Debug)]
+#[command(allow_negative_numbers = true)]
 pub struct Args {
     /// Directory for tracks.csv, truth.csv and truth.json
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
-    /// Number of collisions
+    /// Number of collisions (at most 2000)
     #[arg(long, default_value_t = 60)]
     n: usize,
     #[arg(long, default_value_t = 1)]
@@ -96,10 +97,22 @@ pub struct Args {
     /// film the same time window, in proportionally more frames
     #[arg(long = "camera-study")]
     camera_study: bool,
-    /// Collisions per camera and speed in the camera study
+    /// Collisions per camera and speed in the camera study (at most 500)
     #[arg(long = "study-n", default_value_t = 200)]
     study_n: usize,
 }
+
+/// Most collisions one run simulates.
+const MAX_COLLISIONS: usize = 2000;
+/// Most collisions per camera and speed in the camera study (28 points: 1000 took about 1 s).
+const MAX_STUDY_N: usize = 500;
+/// Most frames per phase, and most frames per phase times collisions (the defaults, 12 and 60,
+/// make 720; 5000 collisions of 12 frames took about 1 s).
+const MAX_FRAMES: usize = 1000;
+const MAX_FRAME_WORK: usize = 24_000;
+/// The same for the camera study, which films each collision with four cameras, up to five
+/// times the frames (1000 collisions of 12 frames per camera and speed took about 1 s).
+const MAX_FRAME_WORK_STUDY: usize = 6_000;
 
 fn parse_model(s: &str) -> Result<ModelKind, String> {
     match s.parse::<ModelKind>()? {
@@ -178,6 +191,33 @@ pub fn run(args: Args) -> CliResult {
     if args.n == 0 || args.pixels_x == 0 || args.pixels_y == 0 {
         return Err("--n, --pixels-x and --pixels-y must be > 0".into());
     }
+    // Caps that keep a run well under a second (10 000 collisions took 1.4 s and wrote 37 MB;
+    // a campaign like the paper's has 60-200): more collisions come from further seeds.
+    if args.n > MAX_COLLISIONS {
+        return Err(format!(
+            "--n {}: expected at most {MAX_COLLISIONS} collisions per run (run again with another --seed for more)",
+            args.n
+        ));
+    }
+    if args.camera_study && !(1..=MAX_STUDY_N).contains(&args.study_n) {
+        return Err(format!(
+            "--study-n {}: expected 1 to {MAX_STUDY_N} collisions per camera and speed",
+            args.study_n
+        ));
+    }
+    let frames_max = args.frames.get(1).copied().unwrap_or(0);
+    let (work, budget) = if args.camera_study {
+        (args.study_n, MAX_FRAME_WORK_STUDY)
+    } else {
+        (args.n, MAX_FRAME_WORK)
+    };
+    if frames_max > MAX_FRAMES || work.saturating_mul(frames_max) > budget {
+        return Err(format!(
+            "--frames {},{frames_max} with {work} collisions: expected at most {MAX_FRAMES} frames per phase and {budget} frames per phase times collisions (--{})",
+            args.frames.first().copied().unwrap_or(0),
+            if args.camera_study { "study-n" } else { "n" }
+        ));
+    }
     if args.frames[0] < 2 || args.frames[1] < args.frames[0] {
         return Err(format!(
             "--frames {},{}: expected 2 <= MIN <= MAX",
@@ -207,8 +247,20 @@ pub fn run(args: Args) -> CliResult {
         camera,
         ..ExperimentSpec::paper()
     };
-    let s1 = restitution::contact::Sphere::new(spec.d1_m, material).map_err(|e| e.to_string())?;
-    let s2 = restitution::contact::Sphere::new(spec.d2_m, material).map_err(|e| e.to_string())?;
+    let s1 = restitution::contact::Sphere::new(spec.d1_m, material)
+        .map_err(|e| format!("--d-mm {}: {e}", args.d_mm))?;
+    let s2 = restitution::contact::Sphere::new(spec.d2_m, material)
+        .map_err(|e| format!("--d2-mm {d2_mm}: {e}"))?;
+    // What a failure of the simulation is due to: the flags that set the physics.
+    let context = format!(
+        "the virtual experiment failed with --d-mm {} --d2-mm {d2_mm} --model {} --eta {} --sigma-y-pa {} --v-n-m-s {},{}",
+        args.d_mm,
+        args.model.name(),
+        args.eta,
+        args.sigma_y_pa,
+        args.v_n_m_s[0],
+        args.v_n_m_s[1]
+    );
     let contact = Pair::unequal(s1, s2).contact();
     let params: Vec<f64> = match args.model {
         ModelKind::Vm => vec![args.eta],
@@ -227,9 +279,9 @@ pub fn run(args: Args) -> CliResult {
     };
     let mut rng = StdRng::seed_from_u64(args.seed);
     if args.camera_study {
-        return study(&args, &spec, &e_of, &mut rng);
+        return study(&args, &spec, &e_of, &mut rng).map_err(|e| format!("{context}: {e}"));
     }
-    let sims = simulate(&spec, &e_of, &mut rng).map_err(|e| e.to_string())?;
+    let sims = simulate(&spec, &e_of, &mut rng).map_err(|e| format!("{context}: {e}"))?;
 
     let tracks: Vec<CollisionTrack> = sims
         .iter()
@@ -399,8 +451,17 @@ fn study(
             fmt_num(p.v_n_m_s),
             p.simulated.to_string(),
             p.measured.to_string(),
-            fmt_num(p.bias),
-            fmt_num(p.scatter),
+            // No bias or scatter without measured collisions: left empty ("measured" says why).
+            if p.bias.is_finite() {
+                fmt_num(p.bias)
+            } else {
+                String::new()
+            },
+            if p.scatter.is_finite() {
+                fmt_num(p.scatter)
+            } else {
+                String::new()
+            },
         ]);
     }
     let title = format!(

@@ -44,6 +44,25 @@ impl fmt::Display for DataError {
 
 impl std::error::Error for DataError {}
 
+/// A cell's text as an error message shows it: on one line (line breaks and other control
+/// characters escaped) and at most 40 characters (then `...`), so that one bad cell, however
+/// long, is still one line of message.
+pub fn shown(raw: &str) -> String {
+    let mut out = String::new();
+    for (i, c) in raw.chars().enumerate() {
+        if i == 40 {
+            out += "...";
+            break;
+        }
+        if c.is_control() {
+            out.extend(c.escape_default());
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
 /// Formats a number in shortest round-trip form (Rust's `{}`/`{:e}` print the fewest digits that
 /// parse back to the same f64); exponent form outside [1e-4, 1e16).
 pub fn fmt_num(x: f64) -> String {
@@ -66,5 +85,17 @@ mod tests {
         }
         assert_eq!(fmt_num(0.1), "0.1");
         assert_eq!(fmt_num(1e-8), "1e-8");
+        // Subnormals and the ends of f64 too.
+        for x in [5e-324, -2.2250738585072014e-308, f64::MAX, f64::MIN, -0.0] {
+            assert_eq!(fmt_num(x).parse::<f64>().unwrap().to_bits(), x.to_bits());
+        }
+    }
+
+    #[test]
+    fn shown_text_is_one_short_line() {
+        assert_eq!(shown("0,97"), "0,97");
+        assert_eq!(shown("a\nb\r\t"), "a\\nb\\r\\t");
+        let long = "x".repeat(100);
+        assert_eq!(shown(&long), format!("{}...", "x".repeat(40)));
     }
 }

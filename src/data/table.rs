@@ -12,7 +12,7 @@
 //! parses them as records. If such a line opens a quote that csv carries onto the next lines, the
 //! reader restarts on the following line, so that a comment can never swallow data.
 
-use super::DataError;
+use super::{DataError, shown};
 use std::fs;
 use std::path::Path;
 
@@ -111,7 +111,7 @@ fn field_text(
                 column: Some(column.map_or_else(|| format!("field {}", j + 1), str::to_string)),
                 message: format!(
                     "'{}' is not UTF-8 text (byte 0x{bad:02X}): save the file as UTF-8",
-                    String::from_utf8_lossy(raw).trim()
+                    shown(String::from_utf8_lossy(raw).trim())
                 ),
             })
         }
@@ -197,7 +197,7 @@ impl Table {
                     {
                         return Err(err(
                             Some(line),
-                            format!("header names column '{}' twice", dup.1),
+                            format!("header names column '{}' twice", shown(dup.1)),
                         ));
                     }
                     header = Some((line, fields));
@@ -206,12 +206,7 @@ impl Table {
                     if rec.len() != h.len() {
                         return Err(err(
                             Some(line),
-                            format!(
-                                "has {} fields, the header (line {}) has {}",
-                                rec.len(),
-                                header.as_ref().map_or(0, |h| h.0),
-                                h.len()
-                            ),
+                            format!("has {} fields, the header has {}", rec.len(), h.len()),
                         ));
                     }
                     let fields = (0..rec.len())
@@ -250,7 +245,7 @@ impl Table {
             column: Some(name.to_string()),
             message: format!(
                 "required column is missing (header has: {})",
-                self.headers.join(",")
+                shown(&self.headers.join(","))
             ),
         })
     }
@@ -265,13 +260,27 @@ impl Table {
         }
     }
 
+    /// The text of a cell as messages show it ([`shown`]).
+    pub fn shown(&self, row: &Row, col: usize) -> String {
+        shown(&row.fields[col])
+    }
+
     /// A finite number from a cell ("inf" and "nan" are rejected).
     pub fn number(&self, row: &Row, col: usize) -> Result<f64, DataError> {
         let raw = &row.fields[col];
+        let text = self.shown(row, col);
         match raw.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(v),
-            Ok(_) => Err(self.cell_error(row, col, format!("'{raw}' is not a finite number"))),
-            Err(_) => Err(self.cell_error(row, col, format!("'{raw}' is not a number"))),
+            Ok(_) => Err(self.cell_error(row, col, format!("'{text}' is not a finite number"))),
+            Err(_) if raw.contains('\n') => Err(self.cell_error(
+                row,
+                col,
+                format!(
+                    "'{text}' is not a number: a quoted field runs over {} lines (is a closing quote missing?)",
+                    raw.lines().count()
+                ),
+            )),
+            Err(_) => Err(self.cell_error(row, col, format!("'{text}' is not a number"))),
         }
     }
 
@@ -290,7 +299,10 @@ impl Table {
             Err(self.cell_error(
                 row,
                 col,
-                format!("'{}' is out of range: expected {expected}", row.fields[col]),
+                format!(
+                    "'{}' is out of range: expected {expected}",
+                    self.shown(row, col)
+                ),
             ))
         }
     }

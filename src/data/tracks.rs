@@ -5,7 +5,7 @@
 //! tracks), optional spins measured from markers `w1z_rad_s,w2z_rad_s` (before) and
 //! `w1z_post_rad_s,w2z_post_rad_s` (after), constant within a collision.
 
-use super::{CsvOut, DataError, Table, fmt_num};
+use super::{CsvOut, DataError, Table, fmt_num, shown};
 use crate::kinematics::Frame;
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
@@ -77,7 +77,7 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
                     return Err(table.cell_error(
                         row,
                         c,
-                        format!("'{other}' is not a phase: expected pre or post"),
+                        format!("'{}' is not a phase: expected pre or post", shown(other)),
                     ));
                 }
             },
@@ -119,7 +119,8 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
                     col,
                     format!(
                         "'{}' differs from the collision's first row (line {})",
-                        row.fields[col], acc.track.first_line
+                        table.shown(row, col),
+                        acc.track.first_line
                     ),
                 ));
             }
@@ -132,8 +133,9 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
                 row,
                 t_col,
                 format!(
-                    "time {} appears twice in collision '{id}'",
-                    row.fields[t_col]
+                    "time {} appears twice in collision '{}'",
+                    table.shown(row, t_col),
+                    shown(&id)
                 ),
             ));
         }
@@ -162,7 +164,7 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
                     column: Some("phase".into()),
                     message: format!(
                         "a 'pre' frame comes after a 'post' frame in collision '{}'",
-                        acc.track.id
+                        shown(&acc.track.id)
                     ),
                 });
             }

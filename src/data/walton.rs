@@ -67,8 +67,10 @@ pub fn read_collisions(
             h == "d1_mm" || h == "d2_mm" || h == "collision" || c1.contains(h) || c2.contains(h);
         if !known {
             warnings.push(format!(
-                "{}:{}: ignoring unknown column '{h}'",
-                table.path, table.header_line
+                "{}:{}: ignoring unknown column '{}'",
+                table.path,
+                table.header_line,
+                super::shown(h)
             ));
         }
     }
@@ -102,7 +104,7 @@ pub fn read_collisions(
                 column: Some(names[j].clone()),
                 message: format!(
                     "required column is missing (needed for a sphere-sphere collision, d2_mm = {})",
-                    row.fields[d2c]
+                    table.shown(row, d2c)
                 ),
             }),
             None => Ok(0.0),
@@ -123,7 +125,7 @@ pub fn read_collisions(
                     c,
                     format!(
                         "'{}': a wall (d2_mm = inf) is at rest; leave its velocity and spin columns empty or 0",
-                        row.fields[c]
+                        table.shown(row, c)
                     ),
                 ));
             }
@@ -218,7 +220,18 @@ pub fn measure_records(
                     fmt_num(approach)
                 )));
             }
-            walton::measure(&r.pre, &r.post).map_err(|e| err(e.to_string()))
+            let m = walton::measure(&r.pre, &r.post).map_err(|e| err(e.to_string()))?;
+            // The fit weights by squared speeds and sums over collisions: each must stay finite.
+            let speeds = [m.v_n_m_s, m.v_s_m_s];
+            if !m.e.is_finite() || speeds.iter().any(|v| !(v * v * 1e6).is_finite()) {
+                return Err(err(format!(
+                    "out of range: v_n = {} m/s, |v_s| = {} m/s, e = {} (squares of speeds must stay finite)",
+                    fmt_num(m.v_n_m_s),
+                    fmt_num(m.v_s_m_s),
+                    fmt_num(m.e)
+                )));
+            }
+            Ok(m)
         })
         .collect()
 }

@@ -390,6 +390,54 @@ pub fn fit(measured: &[Measured], options: &FitOptions) -> Result<WaltonFit> {
             mu0.value
         ),
     };
+    // Every reported number must be finite: data near the edge of f64 can overflow a sum of
+    // squares even when each collision is finite.
+    let reported = [
+        ("e", e_stats.value),
+        ("standard error of e", e_stats.stderr),
+        ("spread of e", e_stats.spread),
+        ("beta0", beta0.value),
+        ("mu0", mu0.value),
+        ("slope", slope.value),
+        ("psi*", kink_psi.value),
+        ("residual rms", residual_rms),
+    ];
+    let optional = [
+        ("standard error of beta0", beta0.stderr),
+        ("standard error of mu0", mu0.stderr),
+        ("standard error of the slope", slope.stderr),
+        ("standard error of psi*", kink_psi.stderr),
+        ("rms centre-of-mass velocity change", com_dv_rms_m_s),
+        ("impulse ratio", impulse_ratio_sliding.map(|r| r.0)),
+        (
+            "standard error of the impulse ratio",
+            impulse_ratio_sliding.map(|r| r.1),
+        ),
+    ];
+    let intervals = [
+        e_stats.ci95,
+        beta0.ci95,
+        mu0.ci95,
+        slope.ci95,
+        kink_psi.ci95,
+    ];
+    let bad = reported
+        .into_iter()
+        .chain(optional.into_iter().filter_map(|(n, v)| v.map(|v| (n, v))))
+        .chain(
+            intervals
+                .into_iter()
+                .flatten()
+                .flat_map(|(lo, hi)| [("95% interval", lo), ("95% interval", hi)]),
+        )
+        .find(|(_, v)| !v.is_finite());
+    if let Some((name, value)) = bad {
+        return Err(Error::InvalidParameter {
+            name,
+            value,
+            expected: "a finite number (the data's magnitudes overflow the fit's sums)",
+        });
+    }
     Ok(WaltonFit {
         e: e_stats,
         beta0,
