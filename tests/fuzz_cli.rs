@@ -82,7 +82,7 @@ fn seeded_walton_fit() {
 
 #[test]
 fn seeded_kinematics() {
-    seeded(Command_::Kinematics, 50, 10);
+    seeded(Command_::Kinematics, 50, 5);
 }
 
 #[test]
@@ -135,9 +135,10 @@ fn extreme_error_bars() {
     assert_clean(&run_all("errbars", &cases));
 }
 
-/// 100 000 rows: read, validated and answered (or refused with one line) within the limit.
+/// 100 000 rows of fit data: read, validated and fitted (or refused with one line) within the
+/// limit, for every model.
 #[test]
-fn hundred_thousand_rows() {
+fn hundred_thousand_rows_fit() {
     let mut cases = Vec::new();
     for m in ["vm", "pm", "powerlaw", "min", "product", "all"] {
         cases.push(file_case(
@@ -148,6 +149,13 @@ fn hundred_thousand_rows() {
             false,
         ));
     }
+    assert_clean(&run_all("bigfit", &cases));
+}
+
+/// 100 000 collisions for `walton fit`, 100 000 frames for `kinematics`.
+#[test]
+fn hundred_thousand_rows_walton_and_kinematics() {
+    let mut cases = Vec::new();
     // 100 000 collisions: the same 60 repeated (ids kept unique by the row).
     let mut spec = SyntheticSpec::paper();
     spec.n = 60;
