@@ -13,6 +13,7 @@
 #![allow(dead_code)]
 
 pub mod cases;
+pub mod sheet;
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
