@@ -3,10 +3,10 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use nalgebra::Vector3;
 use restitution::contact::{Material, Sphere};
-use restitution::fit::walton::{
-    FitOptions, SyntheticSpec, fit, measure_records, synthetic_collisions,
-};
+use restitution::data::walton::measure_records;
+use restitution::fit::walton::{FitOptions, fit};
 use restitution::models::walton::{Body, State, WaltonParams, collide, measure};
+use restitution::synthetic::{SyntheticSpec, synthetic_collisions};
 use std::hint::black_box;
 
 fn bench(c: &mut Criterion) {

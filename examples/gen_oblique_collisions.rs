@@ -1,17 +1,17 @@
 //! Generates `data/oblique_collisions.csv`: synthetic oblique collisions of 25.4 mm nylon spheres
 //! like the paper's Fig. 6 series (about 2 m/s, e = 0.97, mu_0 = 0.175, beta_0 = 0.5), collided
 //! with Walton's operator and blurred with camera-like measurement noise
-//! (`restitution::fit::walton::SyntheticSpec::paper`, whose doc states the noise model).
+//! (`restitution::synthetic::SyntheticSpec::paper`, whose doc states the noise model).
 //!
 //! Run (from the repository root): `cargo run --release --example gen_oblique_collisions`
 //! Options: `--seed S` (default 1997), `--n N` (default 60), `--out PATH`
 //! (default `data/oblique_collisions.csv`), `--truth` (write the noise-free kinematics instead).
 
+use restitution::data::walton::write_collisions;
 use restitution::data::write_atomic;
-use restitution::fit::walton::{
-    CollisionRecord, SyntheticSpec, synthetic_collisions, write_collisions,
-};
+use restitution::fit::walton::CollisionRecord;
 use restitution::models::walton::{Body, Target};
+use restitution::synthetic::{SyntheticSpec, synthetic_collisions};
 use std::path::PathBuf;
 
 fn main() {

@@ -5,9 +5,9 @@
 //! Run: `cargo run --release --example walton_coverage [REPETITIONS] [BOOTSTRAP] [N]`
 //! (defaults 400, 1000, 60). The README's coverage figures come from this program.
 
-use restitution::fit::walton::{
-    FitOptions, SyntheticSpec, Weights, fit, measure_records, synthetic_collisions,
-};
+use restitution::data::walton::measure_records;
+use restitution::fit::walton::{FitOptions, Weights, fit};
+use restitution::synthetic::{SyntheticSpec, synthetic_collisions};
 
 fn main() {
     let args: Vec<usize> = std::env::args()

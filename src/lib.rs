@@ -10,5 +10,6 @@ pub mod fit;
 pub mod kinematics;
 pub mod models;
 pub mod plot;
+pub mod synthetic;
 
 pub use error::{Error, Result};

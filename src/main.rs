@@ -4,6 +4,8 @@ mod cli;
 
 use clap::error::ErrorKind;
 use clap::{Parser, Subcommand};
+use std::any::Any;
+use std::io::Write;
 use std::process::ExitCode;
 
 /// Coefficient of restitution of colliding spheres (Labous, Rosato & Dave, PRE 56, 5717, 1997).
@@ -30,14 +32,35 @@ enum Command {
     Walton(cli::walton::Args),
 }
 
+/// Whether a panic is the standard library's `print!` failing on a closed stdout or stderr (the
+/// reader of a pipe has gone). Subcommands that write through [`cli::emit`] never get there;
+/// this covers the ones that still use `print!`.
+fn is_closed_pipe_panic(payload: &(dyn Any + Send)) -> bool {
+    let text = payload
+        .downcast_ref::<String>()
+        .map(String::as_str)
+        .or_else(|| payload.downcast_ref::<&str>().copied());
+    text.is_some_and(|t| {
+        (t.starts_with("failed printing to stdout") || t.starts_with("failed printing to stderr"))
+            && (t.contains("Broken pipe") || t.contains("os error 32"))
+    })
+}
+
+/// One line on stderr; a closed stderr is ignored (there is nobody to tell).
+fn error_line(message: impl std::fmt::Display) {
+    let _ = writeln!(std::io::stderr(), "restitution: error: {message}");
+}
+
 fn main() -> ExitCode {
-    // Rust ignores SIGPIPE, so `restitution ... | head` would panic on the closed pipe; the
-    // default action ends the process quietly, as Unix tools do.
-    #[cfg(unix)]
-    // SAFETY: restoring the default disposition of SIGPIPE before any thread or I/O exists.
-    unsafe {
-        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
-    }
+    // Rust ignores SIGPIPE, so writing to a closed pipe is an error value, not a signal: a closed
+    // stdout ends the command quietly with exit 0 (as `restitution ... | head` expects), either
+    // through `cli::emit` or, for `print!`, through the panic it raises, silenced here.
+    let default_hook = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        if !is_closed_pipe_panic(info.payload()) {
+            default_hook(info);
+        }
+    }));
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
@@ -51,25 +74,27 @@ fn main() -> ExitCode {
                     let text = e.render().to_string();
                     let first = text.lines().next().unwrap_or("invalid arguments");
                     let first = first.strip_prefix("error: ").unwrap_or(first);
-                    eprintln!("restitution: error: {first} (see --help)");
+                    error_line(format_args!("{first} (see --help)"));
                     ExitCode::from(2)
                 }
             };
         }
     };
-    let result = match cli.command {
+    let run = std::panic::catch_unwind(move || match cli.command {
         Command::Predict(args) => cli::predict::run(args),
         Command::Bench(args) => cli::bench::run(args),
         Command::Fit(args) => cli::fit::run(args),
         Command::Walton(args) => cli::walton::run(args),
         Command::Kinematics(args) => cli::kinematics::run(args),
         Command::Simulate(args) => cli::simulate::run(args),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(msg) => {
-            eprintln!("restitution: error: {msg}");
+    });
+    match run {
+        Ok(Ok(())) => ExitCode::SUCCESS,
+        Ok(Err(msg)) => {
+            error_line(msg);
             ExitCode::FAILURE
         }
+        Err(payload) if is_closed_pipe_panic(payload.as_ref()) => ExitCode::SUCCESS,
+        Err(payload) => std::panic::resume_unwind(payload),
     }
 }

@@ -20,9 +20,10 @@
 
 use super::{CliResult, Format, MaterialArgs};
 use restitution::data::tracks::read_tracks;
-use restitution::data::{fmt_num, write_all_atomic};
+use restitution::data::walton::write_collisions;
+use restitution::data::{CsvOut, fmt_num, write_all_atomic};
 use restitution::experiment::Camera;
-use restitution::fit::walton::{CollisionRecord, write_collisions};
+use restitution::fit::walton::CollisionRecord;
 use restitution::kinematics::{
     Eq8Inputs, FitKind, G_STANDARD_M_S2, Measurement, analyse, measure_collision, split_at_contact,
 };
@@ -31,6 +32,7 @@ use std::path::PathBuf;
 
 /// Velocities, e, beta and psi from tracked sphere centres (Sec. III)
 #[derive(clap::Args, Debug)]
+#[command(allow_negative_numbers = true)]
 pub struct Args {
     /// Tracks CSV (collision, t_s, x1_m, y1_m, x2_m, y2_m, d1_mm, d2_mm [, phase, spins])
     #[arg(value_name = "TRACKS.csv")]
@@ -70,6 +72,9 @@ pub struct Args {
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
 }
+
+/// Most skipped collisions named one by one.
+const MAX_WARNINGS: usize = 20;
 
 const COLUMNS: [&str; 27] = [
     "collision",
@@ -144,7 +149,12 @@ impl Row {
             c.push(fmt_num(x));
         }
         c.push(me.beta.map(fmt_num).unwrap_or_default());
-        c.push(fmt_num(me.psi));
+        // Head-on (no tangential velocity): psi is infinite, left empty like beta.
+        c.push(if me.psi.is_finite() {
+            fmt_num(me.psi)
+        } else {
+            String::new()
+        });
         c.push(fmt_num(dv.x));
         c.push(fmt_num(dv.y));
         c.push(fmt_num(self.d1_mm));
@@ -190,7 +200,11 @@ pub fn run(args: Args) -> CliResult {
     // Two passes: the position noise is one camera's, so the residuals of all collisions are
     // pooled into one estimate (a 10-frame fit alone estimates it poorly), then every error uses it.
     let place = |t: &restitution::data::tracks::CollisionTrack| {
-        format!("{shown}:{}: collision '{}'", t.first_line, t.id)
+        format!(
+            "{shown}:{}: collision '{}'",
+            t.first_line,
+            restitution::data::shown(&t.id)
+        )
     };
     let mut splits = Vec::new();
     let (mut rss, mut dof) = (0.0, 0usize);
@@ -243,86 +257,119 @@ pub fn run(args: Args) -> CliResult {
                 continue;
             }
         };
-        records.push(CollisionRecord {
-            line: t.first_line,
-            id: Some(t.id.clone()),
-            pre: m.pre,
-            post: m.post,
-        });
-        rows.push(Row {
+        let row = Row {
             id: t.id.clone(),
             d1_mm: t.d1_m * 1e3,
             d2_mm: t.d2_m * 1e3,
             m,
+        };
+        // A number is right or it is an error: a collision whose numbers overflowed (absurd
+        // magnitudes in the tracks or flags) is unmeasurable, not printed as NaN.
+        if let Some((col, v)) = COLUMNS
+            .iter()
+            .zip(row.cells())
+            .find(|(c, v)| **c != "collision" && (v == "NaN" || v.ends_with("inf")))
+        {
+            skipped.push(format!(
+                "{}: {col} = {v} (the tracks or flags are out of range)",
+                place(t)
+            ));
+            continue;
+        }
+        records.push(CollisionRecord {
+            line: t.first_line,
+            id: Some(t.id.clone()),
+            pre: row.m.pre,
+            post: row.m.post,
         });
+        rows.push(row);
     }
     if !skipped.is_empty() {
         if args.strict || rows.is_empty() {
             return Err(skipped.swap_remove(0));
         }
-        for s in &skipped {
-            eprintln!("restitution: warning: skipped {s}");
+        // One line each, up to a screenful; a file of 100 000 bad tracks gets a count.
+        for s in skipped.iter().take(MAX_WARNINGS) {
+            super::warn(format_args!("skipped {s}"));
+        }
+        if skipped.len() > MAX_WARNINGS {
+            super::warn(format_args!(
+                "skipped {} more collisions that cannot be measured",
+                skipped.len() - MAX_WARNINGS
+            ));
         }
     }
-    let fallbacks: Vec<&str> = rows
+    let fallbacks: Vec<String> = rows
         .iter()
         .filter(|r| r.m.kinematics.time_rule != restitution::kinematics::TimeRule::ContactDistance)
-        .map(|r| r.id.as_str())
+        .map(|r| restitution::data::shown(&r.id))
         .collect();
     if !fallbacks.is_empty() {
-        eprintln!(
-            "restitution: warning: {} collision(s) never reach contact distance on the pre-collision fits (noise); their time is where pre and post fits meet: {}",
+        super::warn(format_args!(
+            "{} collision(s) never reach contact distance on the pre-collision fits (noise); their time is where pre and post fits meet: {}",
             fallbacks.len(),
-            fallbacks.join(", ")
-        );
+            fallbacks[..fallbacks.len().min(MAX_WARNINGS)].join(", ")
+                + if fallbacks.len() > MAX_WARNINGS {
+                    ", ..."
+                } else {
+                    ""
+                }
+        ));
     }
-    let table_csv = {
-        let mut s = COLUMNS.join(",") + "\n";
-        for r in &rows {
-            s += &(r.cells().join(",") + "\n");
+    let comment = format!(
+        "made by restitution kinematics from {shown} ({})",
+        if args.fixed_gravity {
+            "fixed-gravity fits"
+        } else {
+            "free quadratic fits"
         }
-        s
+    );
+    let table_csv = |comment: Option<&str>| {
+        let mut out = CsvOut::new();
+        if let Some(c) = comment {
+            out.comment(c);
+        }
+        out.record(COLUMNS);
+        for r in &rows {
+            out.record(r.cells());
+        }
+        out.into_string()
     };
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
-        let mut fit_csv = String::from("d_mm,d2_mm,v_n_m_s,e,e_err\n");
+        let mut fit_csv = CsvOut::new();
+        fit_csv.comment(&comment);
+        fit_csv.record(["d_mm", "d2_mm", "v_n_m_s", "e", "e_err"]);
         for r in &rows {
-            fit_csv += &format!(
-                "{},{},{},{},{}\n",
+            fit_csv.record([
                 fmt_num(r.d1_mm),
                 fmt_num(r.d2_mm),
                 fmt_num(r.m.measured.v_n_m_s),
                 fmt_num(r.m.measured.e),
-                fmt_num(r.m.e_err)
-            );
+                fmt_num(r.m.e_err),
+            ]);
         }
-        let header = format!(
-            "# made by restitution kinematics from {shown} ({})\n",
-            if args.fixed_gravity {
-                "fixed-gravity fits"
-            } else {
-                "free quadratic fits"
-            }
-        );
+        let mut walton_csv = CsvOut::new();
+        walton_csv.comment(&comment);
         write_all_atomic(&[
             (
                 dir.join("kinematics.csv"),
-                (header.clone() + &table_csv).into_bytes(),
+                table_csv(Some(&comment)).into_bytes(),
             ),
             (
                 dir.join("fit_input.csv"),
-                (header.clone() + &fit_csv).into_bytes(),
+                fit_csv.into_string().into_bytes(),
             ),
             (
                 dir.join("walton_input.csv"),
-                (header + &write_collisions(&records)).into_bytes(),
+                (walton_csv.into_string() + &write_collisions(&records)).into_bytes(),
             ),
         ])
         .map_err(|e| format!("{}: cannot write: {e}", dir.display()))?;
     }
-    match args.format {
-        Format::Csv => print!("{table_csv}"),
+    let text = match args.format {
+        Format::Csv => table_csv(None),
         Format::Json => {
             let list: Vec<serde_json::Value> = rows
                 .iter()
@@ -344,14 +391,11 @@ pub fn run(args: Args) -> CliResult {
                     serde_json::Value::Object(map)
                 })
                 .collect();
-            println!(
-                "{}",
-                serde_json::to_string_pretty(&list).expect("serialisable")
-            );
+            serde_json::to_string_pretty(&list).expect("JSON values serialise") + "\n"
         }
         Format::Table => {
-            println!(
-                "{:>10} {:>7} {:>9} {:>8} {:>8} {:>8} {:>8} {:>7} {:>7} {:>5}/{:<5} time",
+            let mut s = format!(
+                "{:>10} {:>7} {:>9} {:>8} {:>8} {:>8} {:>8} {:>7} {:>7} {:>5}/{:<5} time\n",
                 "collision",
                 "v_n",
                 "e",
@@ -367,8 +411,8 @@ pub fn run(args: Args) -> CliResult {
             for r in &rows {
                 let me = &r.m.measured;
                 let dv = me.com_velocity_change_m_s.unwrap_or_default();
-                println!(
-                    "{:>10} {:>7.3} {:>9.4} {:>8.4} {:>8.4} {:>8} {:>8.3} {:>7.3} {:>7.3} {:>5}/{:<5} {}",
+                s += &format!(
+                    "{:>10} {:>7.3} {:>9.4} {:>8.4} {:>8.4} {:>8} {:>8} {:>7.3} {:>7.3} {:>5}/{:<5} {}\n",
                     r.id,
                     me.v_n_m_s,
                     me.e,
@@ -377,7 +421,11 @@ pub fn run(args: Args) -> CliResult {
                     me.beta
                         .map(|b| format!("{b:.3}"))
                         .unwrap_or_else(|| "-".into()),
-                    me.psi,
+                    if me.psi.is_finite() {
+                        format!("{:.3}", me.psi)
+                    } else {
+                        "-".into()
+                    },
                     dv.x,
                     dv.y,
                     r.m.kinematics.n_pre,
@@ -385,14 +433,15 @@ pub fn run(args: Args) -> CliResult {
                     r.m.kinematics.time_rule.name()
                 );
             }
-            println!(
-                "(speeds m/s; e_err from the fits' covariance with the position noise pooled over all collisions: {} m = {:.2} subpixels; e_eq8 from Eq. 8 with s = {} subpixels of {} m; dv: momentum check)",
+            s += &format!(
+                "(speeds m/s; e_err from the fits' covariance with the position noise pooled over all collisions: {} m = {:.2} subpixels; e_eq8 from Eq. 8 with s = {} subpixels of {} m; dv: momentum check)\n",
                 fmt_num(sigma),
                 sigma / subpixel_m,
                 fmt_num(args.s_subpixels),
                 fmt_num(subpixel_m)
             );
+            s
         }
-    }
-    Ok(())
+    };
+    super::emit(&text)
 }

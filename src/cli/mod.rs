@@ -2,6 +2,7 @@
 //! arguments struct and a `run` that parses, calls the library and prints.
 
 use restitution::contact::{Material, PRESETS};
+use std::io::{self, Write};
 
 pub mod bench;
 pub mod fit;
@@ -12,6 +13,28 @@ pub mod walton;
 
 /// What a subcommand returns: `Err` is one line for stderr (the binary prefixes it and exits 1).
 pub type CliResult = Result<(), String>;
+
+/// Whether an I/O error says that the reader of our output has gone (`restitution ... | head`).
+pub fn is_closed_pipe(e: &io::Error) -> bool {
+    e.kind() == io::ErrorKind::BrokenPipe
+}
+
+/// Writes a subcommand's output to stdout. A closed stdout is success: whoever reads the output
+/// has taken what they wanted (as `head` does), so the command stops quietly with exit 0, as Unix
+/// tools do; any other write error is an error.
+pub fn emit(text: &str) -> CliResult {
+    let mut out = io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if is_closed_pipe(&e) => Ok(()),
+        Err(e) => Err(format!("cannot write to stdout: {e}")),
+    }
+}
+
+/// A warning line on stderr (`restitution: warning: ...`); a closed stderr is ignored.
+pub fn warn(message: impl std::fmt::Display) {
+    let _ = writeln!(io::stderr(), "restitution: warning: {message}");
+}
 
 /// Material flags shared by the subcommands: a preset or the three constants.
 #[derive(clap::Args, Debug, Clone, Default)]
@@ -42,7 +65,29 @@ impl MaterialArgs {
             });
         }
         match (self.youngs_pa, self.poisson, self.density_kg_m3) {
-            (Some(y), Some(nu), Some(rho)) => Material::new(y, nu, rho).map_err(|e| e.to_string()),
+            (Some(y), Some(nu), Some(rho)) => {
+                for (flag, v, ok, expected) in [
+                    ("--youngs-pa", y, y.is_finite() && y > 0.0, "a modulus > 0 (Pa)"),
+                    (
+                        "--poisson",
+                        nu,
+                        nu.is_finite() && nu > -1.0 && nu < 0.5,
+                        "a number in (-1, 0.5)",
+                    ),
+                    (
+                        "--density-kg-m3",
+                        rho,
+                        rho.is_finite() && rho > 0.0,
+                        "a density > 0 (kg/m^3)",
+                    ),
+                ] {
+                    if !ok {
+                        return Err(format!("{flag} {v}: expected {expected}"));
+                    }
+                }
+                Material::new(y, nu, rho)
+                    .map_err(|e| format!("--youngs-pa, --poisson, --density-kg-m3: {e}"))
+            }
             _ => Err("a material is needed: --material NAME, or all of --youngs-pa, --poisson and --density-kg-m3".into()),
         }
     }

@@ -20,7 +20,7 @@ use rand::SeedableRng;
 use rand::rngs::StdRng;
 use restitution::contact::Pair;
 use restitution::data::tracks::{CollisionTrack, write_tracks};
-use restitution::data::{fmt_num, write_all_atomic};
+use restitution::data::{CsvOut, fmt_num, write_all_atomic};
 use restitution::experiment::{Camera, ExperimentSpec, camera_study, simulate};
 use restitution::fit::models::{ModelKind, predict_e};
 use restitution::models::viscoelastic::{ContactEnd, VmMethod};
@@ -30,11 +30,12 @@ use std::path::PathBuf;
 
 /// A virtual experiment: simulated tracks of oblique collisions seen by a high-speed camera
 #[derive(clap::Args, Debug)]
+#[command(allow_negative_numbers = true)]
 pub struct Args {
     /// Directory for tracks.csv, truth.csv and truth.json
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
-    /// Number of collisions
+    /// Number of collisions (at most 2000)
     #[arg(long, default_value_t = 60)]
     n: usize,
     #[arg(long, default_value_t = 1)]
@@ -93,14 +94,25 @@ pub struct Args {
     spin_noise_rad_s: f64,
     /// Instead of tracks: a Monte Carlo of the measured e's bias and scatter against v_n for
     /// this camera and three better ones (camera_study.csv, camera_study.svg); faster cameras
-    /// film the same time window, in proportionally more frames; faster cameras
     /// film the same time window, in proportionally more frames
     #[arg(long = "camera-study")]
     camera_study: bool,
-    /// Collisions per camera and speed in the camera study
+    /// Collisions per camera and speed in the camera study (at most 500)
     #[arg(long = "study-n", default_value_t = 200)]
     study_n: usize,
 }
+
+/// Most collisions one run simulates.
+const MAX_COLLISIONS: usize = 2000;
+/// Most collisions per camera and speed in the camera study (28 points: 1000 took about 1 s).
+const MAX_STUDY_N: usize = 500;
+/// Most frames per phase, and most frames per phase times collisions (the defaults, 12 and 60,
+/// make 720; 5000 collisions of 12 frames took about 1 s).
+const MAX_FRAMES: usize = 1000;
+const MAX_FRAME_WORK: usize = 24_000;
+/// The same for the camera study, which films each collision with four cameras, up to five
+/// times the frames (1000 collisions of 12 frames per camera and speed took about 1 s).
+const MAX_FRAME_WORK_STUDY: usize = 6_000;
 
 fn parse_model(s: &str) -> Result<ModelKind, String> {
     match s.parse::<ModelKind>()? {
@@ -179,6 +191,33 @@ pub fn run(args: Args) -> CliResult {
     if args.n == 0 || args.pixels_x == 0 || args.pixels_y == 0 {
         return Err("--n, --pixels-x and --pixels-y must be > 0".into());
     }
+    // Caps that keep a run well under a second (10 000 collisions took 1.4 s and wrote 37 MB;
+    // a campaign like the paper's has 60-200): more collisions come from further seeds.
+    if args.n > MAX_COLLISIONS {
+        return Err(format!(
+            "--n {}: expected at most {MAX_COLLISIONS} collisions per run (run again with another --seed for more)",
+            args.n
+        ));
+    }
+    if args.camera_study && !(1..=MAX_STUDY_N).contains(&args.study_n) {
+        return Err(format!(
+            "--study-n {}: expected 1 to {MAX_STUDY_N} collisions per camera and speed",
+            args.study_n
+        ));
+    }
+    let frames_max = args.frames.get(1).copied().unwrap_or(0);
+    let (work, budget) = if args.camera_study {
+        (args.study_n, MAX_FRAME_WORK_STUDY)
+    } else {
+        (args.n, MAX_FRAME_WORK)
+    };
+    if frames_max > MAX_FRAMES || work.saturating_mul(frames_max) > budget {
+        return Err(format!(
+            "--frames {},{frames_max} with {work} collisions: expected at most {MAX_FRAMES} frames per phase and {budget} frames per phase times collisions (--{})",
+            args.frames.first().copied().unwrap_or(0),
+            if args.camera_study { "study-n" } else { "n" }
+        ));
+    }
     if args.frames[0] < 2 || args.frames[1] < args.frames[0] {
         return Err(format!(
             "--frames {},{}: expected 2 <= MIN <= MAX",
@@ -208,8 +247,20 @@ pub fn run(args: Args) -> CliResult {
         camera,
         ..ExperimentSpec::paper()
     };
-    let s1 = restitution::contact::Sphere::new(spec.d1_m, material).map_err(|e| e.to_string())?;
-    let s2 = restitution::contact::Sphere::new(spec.d2_m, material).map_err(|e| e.to_string())?;
+    let s1 = restitution::contact::Sphere::new(spec.d1_m, material)
+        .map_err(|e| format!("--d-mm {}: {e}", args.d_mm))?;
+    let s2 = restitution::contact::Sphere::new(spec.d2_m, material)
+        .map_err(|e| format!("--d2-mm {d2_mm}: {e}"))?;
+    // What a failure of the simulation is due to: the flags that set the physics.
+    let context = format!(
+        "the virtual experiment failed with --d-mm {} --d2-mm {d2_mm} --model {} --eta {} --sigma-y-pa {} --v-n-m-s {},{}",
+        args.d_mm,
+        args.model.name(),
+        args.eta,
+        args.sigma_y_pa,
+        args.v_n_m_s[0],
+        args.v_n_m_s[1]
+    );
     let contact = Pair::unequal(s1, s2).contact();
     let params: Vec<f64> = match args.model {
         ModelKind::Vm => vec![args.eta],
@@ -228,9 +279,9 @@ pub fn run(args: Args) -> CliResult {
     };
     let mut rng = StdRng::seed_from_u64(args.seed);
     if args.camera_study {
-        return study(&args, &spec, &e_of, &mut rng);
+        return study(&args, &spec, &e_of, &mut rng).map_err(|e| format!("{context}: {e}"));
     }
-    let sims = simulate(&spec, &e_of, &mut rng).map_err(|e| e.to_string())?;
+    let sims = simulate(&spec, &e_of, &mut rng).map_err(|e| format!("{context}: {e}"))?;
 
     let tracks: Vec<CollisionTrack> = sims
         .iter()
@@ -244,17 +295,34 @@ pub fn run(args: Args) -> CliResult {
             spins_rad_s: Some(s.spins_measured_rad_s),
         })
         .collect();
-    let mut truth = String::from(
-        "collision,v_n_m_s,e,beta,psi,contact,v1x_m_s,v1y_m_s,v2x_m_s,v2y_m_s,v1x_post_m_s,v1y_post_m_s,v2x_post_m_s,v2y_post_m_s,w1z_rad_s,w2z_rad_s,w1z_post_rad_s,w2z_post_rad_s\n",
-    );
+    let mut truth = CsvOut::new();
+    truth.record([
+        "collision",
+        "v_n_m_s",
+        "e",
+        "beta",
+        "psi",
+        "contact",
+        "v1x_m_s",
+        "v1y_m_s",
+        "v2x_m_s",
+        "v2y_m_s",
+        "v1x_post_m_s",
+        "v1y_post_m_s",
+        "v2x_post_m_s",
+        "v2y_post_m_s",
+        "w1z_rad_s",
+        "w2z_rad_s",
+        "w1z_post_rad_s",
+        "w2z_post_rad_s",
+    ]);
     for s in &sims {
         let (Target::Sphere(a), Target::Sphere(b)) = (&s.pre.target, &s.post.target) else {
             unreachable!("simulated pairs");
         };
         let (p1, q1) = (&s.pre.sphere, &s.post.sphere);
-        let cells: Vec<String> = [s.v_n_m_s, s.e, s.beta, s.psi]
-            .iter()
-            .map(|&x| fmt_num(x))
+        let cells: Vec<String> = std::iter::once(s.id.clone())
+            .chain([s.v_n_m_s, s.e, s.beta, s.psi].iter().map(|&x| fmt_num(x)))
             .chain(std::iter::once(s.kind.as_str().to_string()))
             .chain(
                 [
@@ -275,7 +343,7 @@ pub fn run(args: Args) -> CliResult {
                 .map(|&x| fmt_num(x)),
             )
             .collect();
-        truth += &format!("{},{}\n", s.id, cells.join(","));
+        truth.record(cells);
     }
     let meta = json!({
         "seed": args.seed,
@@ -302,7 +370,7 @@ pub fn run(args: Args) -> CliResult {
             args.out.join("tracks.csv"),
             write_tracks(&tracks).into_bytes(),
         ),
-        (args.out.join("truth.csv"), truth.into_bytes()),
+        (args.out.join("truth.csv"), truth.into_string().into_bytes()),
         (
             args.out.join("truth.json"),
             (serde_json::to_string_pretty(&meta).expect("serialisable") + "\n").into_bytes(),
@@ -310,14 +378,13 @@ pub fn run(args: Args) -> CliResult {
     ])
     .map_err(|e| format!("{}: cannot write: {e}", args.out.display()))?;
     let frames: usize = sims.iter().map(|s| s.frames.len()).sum();
-    println!(
-        "simulated {} collisions ({} frames, position noise {} m) -> {}/tracks.csv, truth.csv, truth.json",
+    super::emit(&format!(
+        "simulated {} collisions ({} frames, position noise {} m) -> {}/tracks.csv, truth.csv, truth.json\n",
         sims.len(),
         frames,
         fmt_num(camera.sigma_m()),
         args.out.display()
-    );
-    Ok(())
+    ))
 }
 
 /// The camera study: this camera, twice the frame rate, four times the pixels, and both better.
@@ -367,18 +434,35 @@ fn study(
     let speeds = [0.3, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0];
     let points = camera_study(spec, &cameras, &speeds, args.study_n, e_of, rng)
         .map_err(|e| e.to_string())?;
-    let mut csv = String::from("camera,fit,v_n_m_s,simulated,measured,bias,scatter\n");
+    let mut csv = CsvOut::new();
+    csv.record([
+        "camera",
+        "fit",
+        "v_n_m_s",
+        "simulated",
+        "measured",
+        "bias",
+        "scatter",
+    ]);
     for p in &points {
-        csv += &format!(
-            "{},{},{},{},{},{},{}\n",
-            p.camera,
-            p.fit,
+        csv.record([
+            p.camera.to_string(),
+            p.fit.to_string(),
             fmt_num(p.v_n_m_s),
-            p.simulated,
-            p.measured,
-            fmt_num(p.bias),
-            fmt_num(p.scatter)
-        );
+            p.simulated.to_string(),
+            p.measured.to_string(),
+            // No bias or scatter without measured collisions: left empty ("measured" says why).
+            if p.bias.is_finite() {
+                fmt_num(p.bias)
+            } else {
+                String::new()
+            },
+            if p.scatter.is_finite() {
+                fmt_num(p.scatter)
+            } else {
+                String::new()
+            },
+        ]);
     }
     let title = format!(
         "Measured e against true e: {} mm {}, s = {} subpixels, {}-{} frames per phase at the base rate",
@@ -392,14 +476,16 @@ fn study(
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("{}: cannot create: {e}", args.out.display()))?;
     write_all_atomic(&[
-        (args.out.join("camera_study.csv"), csv.into_bytes()),
+        (
+            args.out.join("camera_study.csv"),
+            csv.into_string().into_bytes(),
+        ),
         (args.out.join("camera_study.svg"), svg.into_bytes()),
     ])
     .map_err(|e| format!("{}: cannot write: {e}", args.out.display()))?;
-    println!(
-        "camera study: {} points -> {}/camera_study.csv, camera_study.svg",
+    super::emit(&format!(
+        "camera study: {} points -> {}/camera_study.csv, camera_study.svg\n",
         points.len(),
         args.out.display()
-    );
-    Ok(())
+    ))
 }

@@ -5,8 +5,9 @@
 //! tracks), optional spins measured from markers `w1z_rad_s,w2z_rad_s` (before) and
 //! `w1z_post_rad_s,w2z_post_rad_s` (after), constant within a collision.
 
-use super::{DataError, Table, fmt_num};
+use super::{CsvOut, DataError, Table, fmt_num, shown};
 use crate::kinematics::Frame;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
 /// The frames of one collision, sorted by time.
@@ -49,8 +50,12 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
     struct Acc {
         track: CollisionTrack,
         phases: Vec<(bool, usize)>,
+        /// The times seen, as bits of t + 0.0 (so that -0 and 0 are one time).
+        times: HashSet<u64>,
     }
+    // Hashed look-ups keep a file of 100 000 rows linear, whether it has one collision or many.
     let mut accs: Vec<Acc> = Vec::new();
+    let mut index: HashMap<String, usize> = HashMap::new();
     for row in &table.rows {
         let id = row.fields[id_col].clone();
         if id.is_empty() {
@@ -72,7 +77,7 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
                     return Err(table.cell_error(
                         row,
                         c,
-                        format!("'{other}' is not a phase: expected pre or post"),
+                        format!("'{}' is not a phase: expected pre or post", shown(other)),
                     ));
                 }
             },
@@ -85,9 +90,10 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
                 have_spins = true;
             }
         }
-        let i = match accs.iter().position(|a| a.track.id == id) {
-            Some(i) => i,
+        let i = match index.get(&id) {
+            Some(&i) => i,
             None => {
+                index.insert(id.clone(), accs.len());
                 accs.push(Acc {
                     track: CollisionTrack {
                         id: id.clone(),
@@ -99,6 +105,7 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
                         spins_rad_s: None,
                     },
                     phases: Vec::new(),
+                    times: HashSet::new(),
                 });
                 accs.len() - 1
             }
@@ -112,7 +119,8 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
                     col,
                     format!(
                         "'{}' differs from the collision's first row (line {})",
-                        row.fields[col], acc.track.first_line
+                        table.shown(row, col),
+                        acc.track.first_line
                     ),
                 ));
             }
@@ -120,13 +128,14 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
         if have_spins && acc.track.spins_rad_s.is_none() {
             acc.track.spins_rad_s = Some(spins.map(|w| if w.is_nan() { 0.0 } else { w }));
         }
-        if acc.track.frames.iter().any(|f| f.t_s == t) {
+        if !acc.times.insert((t + 0.0).to_bits()) {
             return Err(table.cell_error(
                 row,
                 t_col,
                 format!(
-                    "time {} appears twice in collision '{id}'",
-                    row.fields[t_col]
+                    "time {} appears twice in collision '{}'",
+                    table.shown(row, t_col),
+                    shown(&id)
                 ),
             ));
         }
@@ -155,7 +164,7 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
                     column: Some("phase".into()),
                     message: format!(
                         "a 'pre' frame comes after a 'post' frame in collision '{}'",
-                        acc.track.id
+                        shown(&acc.track.id)
                     ),
                 });
             }
@@ -171,14 +180,24 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
 pub fn write_tracks(tracks: &[CollisionTrack]) -> String {
     let phases = tracks.iter().all(|t| t.split.is_some());
     let spins = tracks.iter().any(|t| t.spins_rad_s.is_some());
-    let mut s = String::from("collision,t_s,x1_m,y1_m,x2_m,y2_m,d1_mm,d2_mm");
+    let mut header: Vec<&str> = vec![
+        "collision",
+        "t_s",
+        "x1_m",
+        "y1_m",
+        "x2_m",
+        "y2_m",
+        "d1_mm",
+        "d2_mm",
+    ];
     if phases {
-        s += ",phase";
+        header.push("phase");
     }
     if spins {
-        s += &format!(",{}", SPIN_COLUMNS.join(","));
+        header.extend(SPIN_COLUMNS);
     }
-    s += "\n";
+    let mut out = CsvOut::new();
+    out.record(&header);
     for t in tracks {
         for (k, f) in t.frames.iter().enumerate() {
             let mut row = vec![
@@ -197,10 +216,10 @@ pub fn write_tracks(tracks: &[CollisionTrack]) -> String {
             if spins {
                 row.extend(t.spins_rad_s.unwrap_or([0.0; 4]).map(fmt_num));
             }
-            s += &(row.join(",") + "\n");
+            out.record(&row);
         }
     }
-    s
+    out.into_string()
 }
 
 #[cfg(test)]

@@ -126,7 +126,7 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
         if d_mm < 0.1 {
             let msg = format!(
                 "'{}' is below 0.1 mm: is the diameter in metres? (d_mm is millimetres)",
-                row.fields[c_d]
+                table.shown(row, c_d)
             );
             strict_or(&mut tiny, table.cell_error(row, c_d, msg))?;
         }
@@ -136,7 +136,7 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
                 if d2 < 0.1 {
                     let msg = format!(
                         "'{}' is below 0.1 mm: is the diameter in metres? (d2_mm is millimetres)",
-                        row.fields[c]
+                        table.shown(row, c)
                     );
                     strict_or(&mut tiny, table.cell_error(row, c, msg))?;
                 }
@@ -149,7 +149,7 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
         if e > 1.0 {
             let msg = format!(
                 "'{}' is above 1 (kept: possible within the errors of a measurement)",
-                row.fields[c_e]
+                table.shown(row, c_e)
             );
             strict_or(&mut above_one, table.cell_error(row, c_e, msg))?;
         }
@@ -164,7 +164,7 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
                         c_e,
                         format!(
                             "'{}' gives sigma_e = 2 e v_err / v_n = {s}: give an e_err column",
-                            row.fields[c_e]
+                            table.shown(row, c_e)
                         ),
                     ));
                 }

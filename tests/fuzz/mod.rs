@@ -1,0 +1,294 @@
+//! A seeded fuzzer of the `restitution` binary, shared by `tests/fuzz_cli.rs` (a small seeded
+//! subset, part of `cargo test`) and `examples/fuzz_cli.rs` (as many cases as asked).
+//!
+//! Each case is a command line and the files it reads, made from valid data by a few mutations
+//! (extreme magnitudes, zeros, negative values, NaN/inf text, huge and tiny error bars, duplicated
+//! rows, one row, 100 000 rows, bytes that are not UTF-8, quotes and commas in ids, broken CSV
+//! structure) or from flags with extreme values. The binary runs as a subprocess with a time
+//! limit; a case passes when the process ends in time and either succeeds with no NaN or
+//! infinity printed where a number belongs (stdout and every output file), or fails with one
+//! error line (plus warnings) that names the file or the flag, a non-zero exit, and no output
+//! file left behind. A panic, a signal or a timeout fails the case.
+
+#![allow(dead_code)]
+
+pub mod cases;
+pub mod sheet;
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// One command line with the files it reads. In `args`, `{dir}` stands for the case's directory.
+#[derive(Debug, Clone)]
+pub struct Case {
+    pub label: String,
+    pub args: Vec<String>,
+    pub files: Vec<(String, Vec<u8>)>,
+    /// Whether the command writes into `{dir}/out` (checked for NaN, and for emptiness on failure).
+    pub out_dir: bool,
+}
+
+/// What a run gave.
+#[derive(Debug)]
+pub struct Outcome {
+    pub code: Option<i32>,
+    pub stdout: String,
+    pub stderr: String,
+    pub elapsed: Duration,
+    pub timed_out: bool,
+}
+
+/// Runs cases of one binary, each in its own directory under `root`.
+pub struct Runner {
+    pub bin: PathBuf,
+    pub root: PathBuf,
+    pub limit: Duration,
+}
+
+fn drain(mut r: impl Read + Send + 'static) -> std::thread::JoinHandle<Vec<u8>> {
+    std::thread::spawn(move || {
+        let mut v = Vec::new();
+        let _ = r.read_to_end(&mut v);
+        v
+    })
+}
+
+impl Runner {
+    pub fn new(bin: PathBuf, tag: &str) -> Runner {
+        let root =
+            std::env::temp_dir().join(format!("restitution-fuzz-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&root);
+        std::fs::create_dir_all(&root).expect("a temporary directory");
+        Runner {
+            bin,
+            root,
+            limit: Duration::from_secs(2),
+        }
+    }
+
+    pub fn case_dir(&self, index: usize) -> PathBuf {
+        self.root.join(format!("c{index}"))
+    }
+
+    /// Runs `case` (files written first); the process is killed at the time limit.
+    pub fn run(&self, case: &Case, index: usize) -> Outcome {
+        let dir = self.case_dir(index);
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).expect("a case directory");
+        for (name, bytes) in &case.files {
+            std::fs::write(dir.join(name), bytes).expect("writing a case file");
+        }
+        let d = dir.display().to_string();
+        let args: Vec<String> = case.args.iter().map(|a| a.replace("{dir}", &d)).collect();
+        let start = Instant::now();
+        let mut child = Command::new(&self.bin)
+            .args(&args)
+            .current_dir(&dir)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .expect("the binary starts");
+        let out = drain(child.stdout.take().expect("piped"));
+        let err = drain(child.stderr.take().expect("piped"));
+        let mut timed_out = false;
+        let status = loop {
+            match child.try_wait().expect("waiting for the child") {
+                Some(s) => break s,
+                None if start.elapsed() > self.limit => {
+                    timed_out = true;
+                    let _ = child.kill();
+                    break child.wait().expect("reaping the killed child");
+                }
+                None => std::thread::sleep(Duration::from_millis(2)),
+            }
+        };
+        let elapsed = start.elapsed();
+        let stdout = String::from_utf8_lossy(&out.join().unwrap_or_default()).into_owned();
+        let stderr = String::from_utf8_lossy(&err.join().unwrap_or_default()).into_owned();
+        Outcome {
+            code: status.code(),
+            stdout,
+            stderr,
+            elapsed,
+            timed_out,
+        }
+    }
+
+    /// Runs and judges a case; a timeout is retried once (the machine may be busy), and only a
+    /// second timeout counts as a hang. `Err` says what was wrong.
+    pub fn check(&self, case: &Case, index: usize) -> Result<Outcome, String> {
+        let mut o = self.run(case, index);
+        if o.timed_out {
+            o = self.run(case, index);
+        }
+        judge(case, &o, &self.case_dir(index))?;
+        Ok(o)
+    }
+}
+
+/// Words that mean a number is not finite, except those that are ids of the input (an id may
+/// be any text, `inf` included).
+fn non_finite_word_except(text: &str, ids: &[String]) -> Option<String> {
+    text.split(|c: char| !c.is_ascii_alphanumeric())
+        .find(|w| {
+            let l = w.to_ascii_lowercase();
+            (l == "nan" || l == "inf" || l == "infinity") && !ids.iter().any(|id| id.contains(*w))
+        })
+        .map(|w| {
+            let at = text.find(w).unwrap_or(0);
+            let from = text[..at].rfind('\n').map_or(0, |p| p + 1);
+            let to = text[at..].find('\n').map_or(text.len(), |p| at + p);
+            format!("'{w}' in: {}", &text[from..to.min(from + 200)])
+        })
+}
+
+fn non_finite_word(text: &str) -> Option<String> {
+    non_finite_word_except(text, &[])
+}
+
+/// The values of the id columns (`collision`, `id`) of the case's input files.
+fn input_ids(case: &Case) -> Vec<String> {
+    let mut ids = Vec::new();
+    for (name, bytes) in &case.files {
+        if let Ok(t) = restitution::data::Table::parse_bytes(name, bytes) {
+            for col in ["collision", "id"] {
+                if let Some(c) = t.column(col) {
+                    ids.extend(t.rows.iter().map(|r| r.fields[c].clone()));
+                }
+            }
+        }
+    }
+    ids.retain(|id| {
+        let l = id.to_ascii_lowercase();
+        l.contains("nan") || l.contains("inf")
+    });
+    ids
+}
+
+fn files_under(dir: &Path) -> Vec<PathBuf> {
+    let mut out = Vec::new();
+    if let Ok(rd) = std::fs::read_dir(dir) {
+        for e in rd.flatten() {
+            let p = e.path();
+            if p.is_dir() {
+                out.extend(files_under(&p));
+            } else {
+                out.push(p);
+            }
+        }
+    }
+    out
+}
+
+/// The rules every case must keep (see the module doc).
+pub fn judge(case: &Case, o: &Outcome, dir: &Path) -> Result<(), String> {
+    if o.timed_out {
+        return Err(format!(
+            "hang: killed after {:.1} s (twice)",
+            o.elapsed.as_secs_f64()
+        ));
+    }
+    if o.stderr.contains("panicked") || o.code == Some(101) {
+        return Err(format!("panic: {}", o.stderr.trim()));
+    }
+    let Some(code) = o.code else {
+        return Err("killed by a signal".into());
+    };
+    let out_dir = dir.join("out");
+    if code == 0 {
+        let ids = input_ids(case);
+        if let Some(w) = non_finite_word_except(&o.stdout, &ids) {
+            return Err(format!("non-finite number on stdout: {w}"));
+        }
+        if case.out_dir {
+            for f in files_under(&out_dir) {
+                let text =
+                    String::from_utf8_lossy(&std::fs::read(&f).unwrap_or_default()).into_owned();
+                if let Some(w) = non_finite_word_except(&text, &ids) {
+                    return Err(format!("non-finite number in {}: {w}", f.display()));
+                }
+            }
+        }
+        return Ok(());
+    }
+    let lines: Vec<&str> = o
+        .stderr
+        .lines()
+        .filter(|l| !l.starts_with("restitution: warning: "))
+        .collect();
+    if lines.len() != 1 || !lines[0].starts_with("restitution: error: ") {
+        return Err(format!(
+            "exit {code} without one error line: {:?}",
+            o.stderr
+        ));
+    }
+    let line = lines[0];
+    let names_file = case.files.iter().any(|(n, _)| line.contains(n.as_str()));
+    let names_flag = line.contains("--") || line.contains("(see --help)");
+    if !(names_file || names_flag) {
+        return Err(format!("the error names neither a file nor a flag: {line}"));
+    }
+    if let Some(w) = non_finite_word(&o.stdout) {
+        return Err(format!("non-finite number on stdout of a failed run: {w}"));
+    }
+    if case.out_dir {
+        let left = files_under(&out_dir);
+        if !left.is_empty() {
+            return Err(format!("failed, but left output files: {left:?}"));
+        }
+    }
+    Ok(())
+}
+
+/// The binary next to the running program (`target/<profile>/restitution` for an example in
+/// `target/<profile>/examples/`).
+pub fn sibling_binary() -> PathBuf {
+    let exe = std::env::current_exe().expect("the running program's path");
+    let dir = exe
+        .parent()
+        .and_then(Path::parent)
+        .expect("target/<profile>");
+    dir.join(format!("restitution{}", std::env::consts::EXE_SUFFIX))
+}
+
+/// Summary of a batch: (cases, successes, clean errors, failures with their descriptions).
+#[derive(Debug, Default)]
+pub struct Tally {
+    pub cases: usize,
+    pub ok: usize,
+    pub errors: usize,
+    pub slowest: (f64, String),
+    pub failures: Vec<String>,
+}
+
+impl Tally {
+    pub fn add(&mut self, case: &Case, result: Result<Outcome, String>) {
+        self.cases += 1;
+        match result {
+            Ok(o) => {
+                if o.code == Some(0) {
+                    self.ok += 1;
+                } else {
+                    self.errors += 1;
+                }
+                let t = o.elapsed.as_secs_f64();
+                if t > self.slowest.0 {
+                    self.slowest = (t, case.label.clone());
+                }
+            }
+            Err(why) => self.failures.push(format!(
+                "{}\n    restitution {}\n    files: {}\n    {why}",
+                case.label,
+                case.args.join(" "),
+                case.files
+                    .iter()
+                    .map(|(n, b)| format!("{n} ({} bytes)", b.len()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )),
+        }
+    }
+}

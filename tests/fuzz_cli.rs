@@ -1,0 +1,479 @@
+//! Every subcommand is total: whatever the input, the binary ends within 2 s with a result free
+//! of NaN/inf or with one clear error line and a non-zero exit; never a panic, never a hang.
+//!
+//! A seeded subset of the fuzzer in `tests/fuzz/` (the larger run: `cargo run --release
+//! --example fuzz_cli -- --cases N`), the cases that found bugs, 100 000-row files, property tests
+//! of the reader and writer, CSV outputs with awkward ids read back, and a closed stdout.
+
+mod fuzz;
+
+use fuzz::cases::{Command as Command_, Sheet, case_of, fig7};
+use fuzz::{Case, Runner, Tally};
+use proptest::prelude::*;
+use restitution::data::walton::write_collisions;
+use restitution::data::{CsvOut, Table, fmt_num};
+use restitution::synthetic::{SyntheticSpec, synthetic_collisions};
+use std::io::{BufRead, BufReader};
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+use std::sync::Mutex;
+
+fn bin() -> PathBuf {
+    PathBuf::from(env!("CARGO_BIN_EXE_restitution"))
+}
+
+/// The subprocess cases run one at a time, so that the tests of this file do not slow each
+/// other towards the time limit (which detects hangs; it is not a speed test).
+static SERIAL: Mutex<()> = Mutex::new(());
+
+fn run_all(tag: &str, cases: &[Case]) -> Tally {
+    let _guard = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let runner = Runner::new(bin(), tag);
+    let mut tally = Tally::default();
+    for (i, c) in cases.iter().enumerate() {
+        let r = runner.check(c, i);
+        tally.add(c, r);
+    }
+    let _ = std::fs::remove_dir_all(&runner.root);
+    tally
+}
+
+fn assert_clean(t: &Tally) {
+    assert!(
+        t.failures.is_empty(),
+        "{} of {} cases broke the rules:\n\n{}",
+        t.failures.len(),
+        t.cases,
+        t.failures.join("\n\n")
+    );
+}
+
+fn file_case(label: &str, args: &[&str], name: &str, bytes: Vec<u8>, out_dir: bool) -> Case {
+    Case {
+        label: label.into(),
+        args: args.iter().map(|s| s.to_string()).collect(),
+        files: vec![(name.into(), bytes)],
+        out_dir,
+    }
+}
+
+/// Cases 0..n of seed 1 for one subcommand (see `fuzz::cases::case_of`), without the 100 000-row
+/// files (they have their own test); one test per subcommand, so that a failure points at it.
+fn seeded(command: Command_, n: u64, min_ok: usize) {
+    let base = Sheet::parse(&fig7());
+    let cases: Vec<Case> = (0..n)
+        .map(|i| case_of(command, 1, i, &base, false))
+        .collect();
+    let t = run_all(&format!("{command:?}"), &cases);
+    assert_clean(&t);
+    // The mix must exercise results as well as errors.
+    assert!(t.ok >= min_ok, "{} ok, {} errors", t.ok, t.errors);
+}
+
+#[test]
+fn seeded_fit() {
+    seeded(Command_::Fit, 80, 15);
+}
+
+#[test]
+fn seeded_walton_fit() {
+    seeded(Command_::Walton, 50, 10);
+}
+
+#[test]
+fn seeded_kinematics() {
+    seeded(Command_::Kinematics, 50, 5);
+}
+
+#[test]
+fn seeded_predict() {
+    seeded(Command_::Predict, 50, 10);
+}
+
+#[test]
+fn seeded_simulate() {
+    seeded(Command_::Simulate, 40, 5);
+}
+
+#[test]
+fn seeded_bench_flags() {
+    seeded(Command_::Bench, 8, 0);
+}
+
+fn fig7_rows(n: usize, error_column: Option<(&str, &str)>) -> Vec<u8> {
+    let base = Sheet::parse(&fig7());
+    let mut s = base.clone();
+    s.rows = (0..n)
+        .map(|i| base.rows[i % base.rows.len()].clone())
+        .collect();
+    if let Some((name, value)) = error_column {
+        let c = s.col("v_err_m_s").expect("the Fig. 7 data have v_err_m_s");
+        s.header[c] = name.into();
+        for r in &mut s.rows {
+            r[c] = value.into();
+        }
+    }
+    s.to_bytes()
+}
+
+/// Error bars so small (or large) that chi2 spans hundreds of decades: the fits must end.
+#[test]
+fn extreme_error_bars() {
+    let models = ["vm", "pm", "min", "product", "powerlaw", "all"];
+    let mut cases = Vec::new();
+    for (rows, e_err) in [(4, "1e-80"), (4, "1e80"), (120, "1e-80"), (4, "5e-324")] {
+        for m in models {
+            cases.push(file_case(
+                &format!("fit --model {m}, {rows} rows, e_err {e_err}"),
+                &["fit", "data.csv", "--material", "nylon", "--model", m],
+                "data.csv",
+                fig7_rows(rows, Some(("e_err", e_err))),
+                false,
+            ));
+        }
+    }
+    assert_clean(&run_all("errbars", &cases));
+}
+
+/// 100 000 rows of fit data: read, validated and fitted (or refused with one line) within the
+/// limit, for every model.
+#[test]
+fn hundred_thousand_rows_fit() {
+    let mut cases = Vec::new();
+    for m in ["vm", "pm", "powerlaw", "min", "product", "all"] {
+        cases.push(file_case(
+            &format!("fit --model {m}, 100 000 rows"),
+            &["fit", "data.csv", "--material", "nylon", "--model", m],
+            "data.csv",
+            fig7_rows(100_000, None),
+            false,
+        ));
+    }
+    assert_clean(&run_all("bigfit", &cases));
+}
+
+/// 100 000 collisions for `walton fit`, 100 000 frames for `kinematics`.
+#[test]
+fn hundred_thousand_rows_walton_and_kinematics() {
+    let mut cases = Vec::new();
+    // 100 000 collisions: the same 60 repeated (ids kept unique by the row).
+    let mut spec = SyntheticSpec::paper();
+    spec.n = 60;
+    let (_, noisy) = synthetic_collisions(&spec, 5).unwrap();
+    let one = Sheet::parse(&write_collisions(&noisy));
+    let mut many = one.clone();
+    many.rows = (0..100_000)
+        .map(|i| {
+            let mut r = one.rows[i % one.rows.len()].clone();
+            r[0] = format!("c{i}");
+            r
+        })
+        .collect();
+    let walton = many.to_bytes();
+    for boot in ["0", "2000"] {
+        cases.push(file_case(
+            &format!("walton fit, 100 000 collisions, --bootstrap {boot}"),
+            &[
+                "walton",
+                "fit",
+                "c.csv",
+                "--material",
+                "nylon",
+                "--bootstrap",
+                boot,
+            ],
+            "c.csv",
+            walton.clone(),
+            false,
+        ));
+    }
+    // Tracks: 100 000 frames of one collision, and 100 000 one-frame collisions.
+    let mut one_long = CsvOut::new();
+    one_long.record([
+        "collision",
+        "t_s",
+        "x1_m",
+        "y1_m",
+        "x2_m",
+        "y2_m",
+        "d1_mm",
+        "d2_mm",
+    ]);
+    let mut many_short = CsvOut::new();
+    many_short.record([
+        "collision",
+        "t_s",
+        "x1_m",
+        "y1_m",
+        "x2_m",
+        "y2_m",
+        "d1_mm",
+        "d2_mm",
+    ]);
+    for i in 0..100_000 {
+        let t = i as f64 * 1e-5;
+        // Two spheres approaching at 1 m/s each, touching at t = 0.5 s, then parting.
+        let gap = 0.0254 + 2.0 * (0.5 - t).abs();
+        let row = [
+            "a".to_string(),
+            fmt_num(t),
+            fmt_num(-gap / 2.0),
+            "0.1".into(),
+            fmt_num(gap / 2.0),
+            "0.1".into(),
+            "25.4".into(),
+            "25.4".into(),
+        ];
+        one_long.record(&row);
+        let mut short = row.clone();
+        short[0] = format!("c{i}");
+        many_short.record(&short);
+    }
+    for (label, bytes) in [
+        ("kinematics, one collision of 100 000 frames", one_long),
+        ("kinematics, 100 000 one-frame collisions", many_short),
+    ] {
+        cases.push(file_case(
+            label,
+            &["kinematics", "t.csv", "--material", "nylon"],
+            "t.csv",
+            bytes.into_string().into_bytes(),
+            false,
+        ));
+    }
+    assert_clean(&run_all("big", &cases));
+}
+
+/// Quotes, commas, line breaks and a leading `#` in ids survive the CSVs that `walton fit` and
+/// `kinematics` write: each reads back with the same ids.
+#[test]
+fn awkward_ids_round_trip_through_written_csv() {
+    let _guard = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = std::env::temp_dir().join(format!("restitution-ids-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let ids = [
+        "a,b",
+        "say \"hi\"",
+        "two\nlines",
+        "#3",
+        "caf\u{e9}",
+        "plain",
+    ];
+    let id = |i: usize| format!("{} {i}", ids[i % ids.len()]);
+
+    // walton fit: the collisions' ids into walton_collisions.csv.
+    let (_, mut noisy) = synthetic_collisions(&SyntheticSpec::paper(), 8).unwrap();
+    for (i, r) in noisy.iter_mut().enumerate() {
+        r.id = Some(id(i));
+    }
+    let input = dir.join("collisions.csv");
+    std::fs::write(&input, write_collisions(&noisy)).unwrap();
+    let out = dir.join("walton");
+    let st = Command::new(bin())
+        .args(["walton", "fit"])
+        .arg(&input)
+        .args(["--material", "nylon", "--bootstrap", "50", "--out"])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let t = Table::read(&out.join("walton_collisions.csv")).unwrap();
+    let c = t.require("collision").unwrap();
+    let got: Vec<&str> = t.rows.iter().map(|r| r.fields[c].as_str()).collect();
+    let want: Vec<String> = (0..noisy.len()).map(id).collect();
+    assert_eq!(got, want);
+    let csv = Table::read(&out.join("walton.csv")).unwrap();
+    assert_eq!(csv.rows.len(), 5);
+
+    // kinematics: simulated tracks renamed with awkward ids, through all three CSVs.
+    let sim = dir.join("sim");
+    let st = Command::new(bin())
+        .args(["simulate", "--material", "nylon", "--n", "6", "--out"])
+        .arg(&sim)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let tracks = Table::read(&sim.join("tracks.csv")).unwrap();
+    let c = tracks.require("collision").unwrap();
+    let mut w = CsvOut::new();
+    w.record(&tracks.headers);
+    for r in &tracks.rows {
+        let mut f = r.fields.clone();
+        // The simulated ids are c1, c2, ...
+        let n: usize = f[c].trim_start_matches('c').parse().unwrap();
+        f[c] = id(n);
+        w.record(&f);
+    }
+    let renamed = dir.join("tracks.csv");
+    std::fs::write(&renamed, w.into_string()).unwrap();
+    let kin = dir.join("kin");
+    let st = Command::new(bin())
+        .arg("kinematics")
+        .arg(&renamed)
+        .args(["--material", "nylon", "--fixed-gravity", "--out"])
+        .arg(&kin)
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let k = Table::read(&kin.join("kinematics.csv")).unwrap();
+    let kc = k.require("collision").unwrap();
+    let got: Vec<String> = k.rows.iter().map(|r| r.fields[kc].clone()).collect();
+    let want: Vec<String> = (1..=6).map(id).collect();
+    assert_eq!(got, want);
+    let wi = Table::read(&kin.join("walton_input.csv")).unwrap();
+    let wc = wi.require("collision").unwrap();
+    let got: Vec<String> = wi.rows.iter().map(|r| r.fields[wc].clone()).collect();
+    assert_eq!(got, want);
+    let fi = Table::read(&kin.join("fit_input.csv")).unwrap();
+    assert_eq!(fi.rows.len(), 6);
+    // And the chain goes on: the walton input is read by walton fit.
+    let st = Command::new(bin())
+        .args(["walton", "fit"])
+        .arg(kin.join("walton_input.csv"))
+        .args(["--material", "nylon", "--bootstrap", "0", "--format", "csv"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&st.stderr);
+    assert!(
+        st.status.success() || err.starts_with("restitution: error: "),
+        "{err}"
+    );
+    assert!(!err.contains("line") || !err.contains("fields"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// `restitution ... | head -1`: the reader goes away after one line; the command exits 0
+/// quietly. Through `print!` (predict) and through the checked writer (walton fit).
+#[test]
+fn closed_stdout_is_success() {
+    let _guard = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let dir = std::env::temp_dir().join(format!("restitution-pipe-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    // Well over a pipe's 64 KiB, so that the writer is still writing when the reader leaves.
+    let speeds: Vec<String> = (1..=3000).map(|i| format!("{}", i as f64 * 0.01)).collect();
+    let (_, mut noisy) = synthetic_collisions(
+        &SyntheticSpec {
+            n: 1500,
+            ..SyntheticSpec::paper()
+        },
+        2,
+    )
+    .unwrap();
+    noisy.iter_mut().for_each(|r| r.id = None);
+    let input = dir.join("c.csv");
+    std::fs::write(&input, write_collisions(&noisy)).unwrap();
+    let commands: Vec<Vec<String>> = vec![
+        [
+            "predict",
+            "--model",
+            "vm",
+            "--material",
+            "nylon",
+            "--d-mm",
+            "25.4",
+            "--eta",
+            "190",
+            "--v-m-s",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain([speeds.join(",")])
+        .collect(),
+        vec![
+            "walton".into(),
+            "fit".into(),
+            input.display().to_string(),
+            "--material".into(),
+            "nylon".into(),
+            "--bootstrap".into(),
+            "0".into(),
+            "--format".into(),
+            "json".into(),
+        ],
+    ];
+    for args in commands {
+        let mut child = Command::new(bin())
+            .args(&args)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut first = String::new();
+        {
+            let mut out = BufReader::new(child.stdout.take().unwrap());
+            out.read_line(&mut first).unwrap();
+        } // The read end closes here, as `head -1` closes it.
+        let o = child.wait_with_output().unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!first.is_empty(), "{}: no first line", args[0]);
+        assert_eq!(o.status.code(), Some(0), "{}: {err}", args[0]);
+        assert!(err.is_empty(), "{}: stderr {err}", args[0]);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A fit case whose data have one cell replaced by `value`.
+fn one_cell_case(col: &str, row: usize, value: &str, model: &str) -> Case {
+    let base = Sheet::parse(&fig7());
+    let mut s = base.clone();
+    s.rows.truncate(12);
+    let c = s.col(col).unwrap();
+    s.rows[row][c] = value.into();
+    file_case(
+        &format!("fit --model {model}, {col}[{row}] = {value}"),
+        &[
+            "fit",
+            "data.csv",
+            "--material",
+            "nylon",
+            "--model",
+            model,
+            "--format",
+            "csv",
+        ],
+        "data.csv",
+        s.to_bytes(),
+        false,
+    )
+}
+
+/// Any f64 at all, as Rust prints it (finite, subnormal, huge, zero, negative, NaN, inf).
+fn any_number() -> impl Strategy<Value = String> {
+    prop_oneof![
+        any::<f64>().prop_map(|x| format!("{x}")),
+        any::<f64>().prop_map(|x| format!("{x:e}")),
+        (-330i32..330).prop_map(|e| format!("1e{e}")),
+        Just("-0".to_string()),
+    ]
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// One cell of the fit data replaced by any number: a result or one clear error.
+    #[test]
+    fn fit_takes_any_number_in_any_cell(
+        col in prop::sample::select(vec!["d_mm", "v_n_m_s", "e", "v_err_m_s"]),
+        row in 0usize..12,
+        value in any_number(),
+        model in prop::sample::select(vec!["vm", "pm", "powerlaw", "min"]),
+    ) {
+        let case = one_cell_case(col, row, &value, model);
+        let t = run_all("prop", &[case]);
+        prop_assert!(t.failures.is_empty(), "{}", t.failures.join("\n"));
+    }
+}
