@@ -21,6 +21,20 @@ fn master_curve(c: &mut Criterion) {
     g.finish();
 }
 
+/// The large-kappa laws (kappa >= 10): correctly rounded A kappa^-5 (overlap) and the force rule's
+/// table (to 1e7) and law, in double-double.
+fn master_curve_large(c: &mut Criterion) {
+    let mut g = c.benchmark_group("master_e_of_kappa_large");
+    for kappa in [1e3, 1e20, 1e300] {
+        for rule in ContactEnd::ALL {
+            g.bench_with_input(BenchmarkId::new(rule.name(), kappa), &kappa, |b, &k| {
+                b.iter(|| restitution(black_box(k), rule, &VmMethod::Master))
+            });
+        }
+    }
+    g.finish();
+}
+
 fn ode_default(c: &mut Criterion) {
     let mut g = c.benchmark_group("ode_default_e_of_kappa");
     g.measurement_time(Duration::from_secs(3));
@@ -38,7 +52,7 @@ fn plastic(c: &mut Criterion) {
     // rebound_u returns e and 1 - e (the latter through a cancellation-free chain for u near 1);
     // e_of_u needs only e, and the compiler drops the rest once it inlines.
     let mut g = c.benchmark_group("plastic_e_of_u");
-    for u in [1.001, 10.0, 1e6] {
+    for u in [1.001, 10.0, 1e6, 1e300] {
         g.bench_with_input(BenchmarkId::new("rebound_u", u), &u, |b, &u| {
             b.iter(|| rebound_u(black_box(u)))
         });
@@ -49,5 +63,11 @@ fn plastic(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, master_curve, ode_default, plastic);
+criterion_group!(
+    benches,
+    master_curve,
+    master_curve_large,
+    ode_default,
+    plastic
+);
 criterion_main!(benches);

@@ -183,7 +183,8 @@ impl PhaseFit {
 }
 
 /// How the collision time was found.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, strum::IntoStaticStr)]
+#[strum(serialize_all = "snake_case")]
 pub enum TimeRule {
     /// Centre distance on the pre-collision fits reaches (d1 + d2)/2.
     ContactDistance,
@@ -192,11 +193,9 @@ pub enum TimeRule {
 }
 
 impl TimeRule {
+    /// `contact_distance` or `fits_meet` (written to kinematics.csv).
     pub fn name(self) -> &'static str {
-        match self {
-            TimeRule::ContactDistance => "contact_distance",
-            TimeRule::FitsMeet => "fits_meet",
-        }
+        self.into()
     }
 }
 

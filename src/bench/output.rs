@@ -88,12 +88,7 @@ impl BenchReport {
                 (c.model).to_string(),
                 (c.method).to_string(),
                 (c.setting).to_string(),
-                (match c.role {
-                    Role::Production => "production",
-                    Role::Comparator => "comparator",
-                    Role::Loose => "loose",
-                })
-                .to_string(),
+                <&str>::from(c.role).to_string(),
                 (c.rule).to_string(),
                 (if c.model == "vm" { "kappa" } else { "u" }).to_string(),
                 csv_num(c.x),

@@ -70,7 +70,8 @@ impl Outcome {
 }
 
 /// Whether a method is one a user computes e with, or a comparator kept to show a failure mode.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, strum::IntoStaticStr)]
+#[strum(serialize_all = "lowercase")]
 pub enum Role {
     /// A way to compute e that the library offers: it must never return a wrong number silently.
     Production,
