@@ -143,13 +143,9 @@ impl Runner {
         }
     }
 
-    /// Runs and judges a case; a timeout is retried once (the machine may be busy), and only a
-    /// second timeout counts as a hang. `Err` says what was wrong.
+    /// Runs and judges a case. `Err` says what was wrong.
     pub fn check(&self, case: &Case, index: usize) -> Result<Outcome, String> {
-        let mut o = self.run(case, index);
-        if o.timed_out {
-            o = self.run(case, index);
-        }
+        let o = self.run(case, index);
         judge(case, &o, &self.case_dir(index))?;
         Ok(o)
     }
@@ -213,7 +209,8 @@ fn files_under(dir: &Path) -> Vec<PathBuf> {
 pub fn judge(case: &Case, o: &Outcome, dir: &Path) -> Result<(), String> {
     if o.timed_out {
         return Err(format!(
-            "hang: killed after {:.1} s (twice)",
+            "hang: killed after {:.1} s of CPU, {:.1} s of wall time",
+            o.cpu.as_secs_f64(),
             o.elapsed.as_secs_f64()
         ));
     }
