@@ -20,7 +20,8 @@ fn per_line(text: &str) -> usize {
             .flexible(true)
             .from_reader(raw.as_bytes());
         if let Some(Ok(rec)) = rdr.records().next() {
-            fields += rec.iter().map(|f| f.trim().to_string()).count();
+            let row: Vec<String> = rec.iter().map(|f| f.trim().to_string()).collect();
+            fields += black_box(row).len();
         }
     }
     fields

@@ -90,7 +90,7 @@ fn main() {
         println!("FAIL {f}\n");
     }
     println!(
-        "{} cases (seed {seed}, from {from}): {} succeeded, {} failed cleanly, {} broke the rules; slowest {:.2} s ({})",
+        "{} cases (seed {seed}, from {from}): {} succeeded, {} failed cleanly, {} broke the rules; slowest {:.2} s of wall time ({})",
         tally.cases,
         tally.ok,
         tally.errors,

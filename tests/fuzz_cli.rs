@@ -1,4 +1,5 @@
-//! Every subcommand is total: whatever the input, the binary ends within 2 s with a result free
+//! Every subcommand is total: whatever the input, the binary ends within 2 s (of CPU: the
+//! machines are shared) with a result free
 //! of NaN/inf or with one clear error line and a non-zero exit; never a panic, never a hang.
 //!
 //! A seeded subset of the fuzzer in `tests/fuzz/` (the larger run: `cargo run --release

@@ -268,19 +268,20 @@ impl Table {
     /// A finite number from a cell ("inf" and "nan" are rejected).
     pub fn number(&self, row: &Row, col: usize) -> Result<f64, DataError> {
         let raw = &row.fields[col];
-        let text = self.shown(row, col);
+        let text = || self.shown(row, col);
         match raw.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(v),
-            Ok(_) => Err(self.cell_error(row, col, format!("'{text}' is not a finite number"))),
+            Ok(_) => Err(self.cell_error(row, col, format!("'{}' is not a finite number", text()))),
             Err(_) if raw.contains('\n') => Err(self.cell_error(
                 row,
                 col,
                 format!(
-                    "'{text}' is not a number: a quoted field runs over {} lines (is a closing quote missing?)",
+                    "'{}' is not a number: a quoted field runs over {} lines (is a closing quote missing?)",
+                    text(),
                     raw.lines().count()
                 ),
             )),
-            Err(_) => Err(self.cell_error(row, col, format!("'{text}' is not a number"))),
+            Err(_) => Err(self.cell_error(row, col, format!("'{}' is not a number", text()))),
         }
     }
 

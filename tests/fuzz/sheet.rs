@@ -144,6 +144,9 @@ pub fn mutate(sheet: &mut Sheet, rng: &mut StdRng, big_rows: bool) -> Vec<String
     for _ in 0..k {
         let ncol = sheet.header.len();
         let nrow = sheet.rows.len();
+        if ncol == 0 {
+            break;
+        }
         let c = rng.random_range(0..ncol);
         let r = rng.random_range(0..nrow.max(1));
         let v = EXTREMES.choose(rng).expect("not empty").to_string();
@@ -154,14 +157,14 @@ pub fn mutate(sheet: &mut Sheet, rng: &mut StdRng, big_rows: bool) -> Vec<String
         };
         let name = match what {
             0..=24 => {
-                if let Some(row) = sheet.rows.get_mut(r) {
-                    row[c] = v.clone();
+                if let Some(cell) = sheet.rows.get_mut(r).and_then(|row| row.get_mut(c)) {
+                    *cell = v.clone();
                 }
                 format!("cell({}, {}) = {v:?}", r, sheet.header[c])
             }
             25..=39 => {
-                for row in &mut sheet.rows {
-                    row[c] = v.clone();
+                for cell in sheet.rows.iter_mut().filter_map(|row| row.get_mut(c)) {
+                    *cell = v.clone();
                 }
                 format!("column {} = {v:?}", sheet.header[c])
             }
@@ -169,9 +172,9 @@ pub fn mutate(sheet: &mut Sheet, rng: &mut StdRng, big_rows: bool) -> Vec<String
                 let f: f64 = *[1e-300, 1e300, -1.0, 0.0, 1e-150, 1e150, 5e-324]
                     .choose(rng)
                     .expect("not empty");
-                for row in &mut sheet.rows {
-                    if let Ok(x) = row[c].parse::<f64>() {
-                        row[c] = format!("{}", x * f);
+                for cell in sheet.rows.iter_mut().filter_map(|row| row.get_mut(c)) {
+                    if let Ok(x) = cell.parse::<f64>() {
+                        *cell = format!("{}", x * f);
                     }
                 }
                 format!("column {} scaled by {f:e}", sheet.header[c])
@@ -199,8 +202,8 @@ pub fn mutate(sheet: &mut Sheet, rng: &mut StdRng, big_rows: bool) -> Vec<String
                 "100 000 rows".into()
             }
             65..=68 => {
-                if let Some(row) = sheet.rows.get_mut(r) {
-                    row[c] = NOT_UTF8.into();
+                if let Some(cell) = sheet.rows.get_mut(r).and_then(|row| row.get_mut(c)) {
+                    *cell = NOT_UTF8.into();
                 }
                 format!("cell({}, {}) not UTF-8", r, sheet.header[c])
             }
@@ -217,19 +220,21 @@ pub fn mutate(sheet: &mut Sheet, rng: &mut StdRng, big_rows: bool) -> Vec<String
                     0
                 });
                 for (i, row) in sheet.rows.iter_mut().enumerate() {
-                    row[col] = format!("{}{i}", IDS[i % IDS.len()]);
+                    if let Some(cell) = row.get_mut(col) {
+                        *cell = format!("{}{i}", IDS[i % IDS.len()]);
+                    }
                 }
                 "awkward ids".into()
             }
             77..=78 => {
-                if let Some(row) = sheet.rows.get_mut(r) {
-                    row[c] = OPEN_QUOTE.into();
+                if let Some(cell) = sheet.rows.get_mut(r).and_then(|row| row.get_mut(c)) {
+                    *cell = OPEN_QUOTE.into();
                 }
                 "unbalanced quote".into()
             }
             79..=80 => {
                 let h = sheet.header.remove(c);
-                for row in &mut sheet.rows {
+                for row in sheet.rows.iter_mut().filter(|row| c < row.len()) {
                     row.remove(c);
                 }
                 format!("column {h} dropped")
@@ -262,10 +267,10 @@ pub fn mutate(sheet: &mut Sheet, rng: &mut StdRng, big_rows: bool) -> Vec<String
             }
             _ => {
                 // A number perturbed within its magnitude: still valid, a different data set.
-                if let Some(row) = sheet.rows.get_mut(r)
-                    && let Ok(x) = row[c].parse::<f64>()
+                if let Some(cell) = sheet.rows.get_mut(r).and_then(|row| row.get_mut(c))
+                    && let Ok(x) = cell.parse::<f64>()
                 {
-                    row[c] = format!("{}", x * rng.random_range(0.5..1.5));
+                    *cell = format!("{}", x * rng.random_range(0.5..1.5));
                 }
                 "a value perturbed".into()
             }
