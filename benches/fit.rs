@@ -6,6 +6,7 @@ use criterion::{Criterion, criterion_group, criterion_main};
 use restitution::contact::Material;
 use restitution::fit::input::read_fit_csv;
 use restitution::fit::report::{self, ReportContext};
+use restitution::fit::report_text;
 use restitution::fit::{FitOptions, ModelKind, fit, fit_all};
 use restitution::models::viscoelastic::{ContactEnd, OdeSettings, VmMethod};
 use restitution::plot::fit::{fig7_svg, residuals_svg};
@@ -56,9 +57,9 @@ fn bench(c: &mut Criterion) {
                 vm_method: &VmMethod::Master,
             };
             let j = report::to_json(&ctx, &set).to_string();
-            let m = report::to_markdown(&ctx, &set);
-            let t = report::to_table(&ctx, &set);
-            let s = report::to_csv(&ctx, &set);
+            let m = report_text::to_markdown(&ctx, &set);
+            let t = report_text::to_table(&ctx, &set);
+            let s = report::to_csv(&ctx, &set).unwrap();
             let f = fig7_svg(data, &set, ContactEnd::Overlap, &VmMethod::Master, "fig7").unwrap();
             let r = residuals_svg(data, &set, "residuals").unwrap();
             j.len() + m.len() + t.len() + s.len() + f.len() + r.len()

@@ -17,6 +17,7 @@ use super::{CliResult, Format, MaterialArgs};
 use restitution::data::write_all_atomic;
 use restitution::fit::input::read_fit_csv;
 use restitution::fit::report::{self, ReportContext};
+use restitution::fit::report_text;
 use restitution::fit::{FitOptions, ModelKind, fit_all};
 use restitution::models::viscoelastic::{ContactEnd, OdeSettings, VmMethod};
 use restitution::plot::fit::{fig7_svg, residuals_svg};
@@ -104,6 +105,7 @@ pub fn run(args: Args) -> CliResult {
     let json = serde_json::to_string_pretty(&report::to_json(&ctx, &set))
         .map_err(|e| format!("cannot render JSON: {e}"))?
         + "\n";
+    let csv = report::to_csv(&ctx, &set)?;
     if let Some(dir) = &args.out {
         let name = args
             .data
@@ -123,12 +125,9 @@ pub fn run(args: Args) -> CliResult {
         let files = vec![
             (
                 dir.join("params.md"),
-                report::to_markdown(&ctx, &set).into_bytes(),
+                report_text::to_markdown(&ctx, &set).into_bytes(),
             ),
-            (
-                dir.join("params.csv"),
-                report::to_csv(&ctx, &set).into_bytes(),
-            ),
+            (dir.join("params.csv"), csv.clone().into_bytes()),
             (dir.join("params.json"), json.clone().into_bytes()),
             (dir.join("fig7.svg"), fig.into_bytes()),
             (dir.join("residuals.svg"), res.into_bytes()),
@@ -137,8 +136,8 @@ pub fn run(args: Args) -> CliResult {
             .map_err(|e| format!("--out {}: cannot write the results: {e}", dir.display()))?;
     }
     match args.format {
-        Format::Table => print!("{}", report::to_table(&ctx, &set)),
-        Format::Csv => print!("{}", report::to_csv(&ctx, &set)),
+        Format::Table => print!("{}", report_text::to_table(&ctx, &set)),
+        Format::Csv => print!("{csv}"),
         Format::Json => print!("{json}"),
     }
     Ok(())

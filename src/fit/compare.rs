@@ -7,7 +7,7 @@
 //! fits within 2 of the best, the one with the fewest parameters (then the lower AIC) is named,
 //! so that the data are not described with more than they support.
 
-use super::engine::FitResult;
+use super::result::FitResult;
 use super::models::ModelKind;
 
 /// How the preferred model is chosen, for reports.

@@ -11,25 +11,23 @@
 //!   Why our own: argmin 0.11 has no Levenberg-Marquardt; its Gauss-Newton needs its own
 //!   operator types and has no damping, which stalls on the plateaus these models have (a
 //!   parameter that stops mattering gives a singular J^T J, which the damping handles); and with
-//!   at most 3 parameters the whole method is a dense 3 x 3 solve per step.
-//! - [`brent_minimize`]: Brent's bracketed minimisation (argmin's `BrentOpt`) for the
-//!   one-parameter models after a grid scan has bracketed the global minimum.
-//! - [`profile_crossing`]: where a profile chi2 crosses a threshold, by bracketing outwards and
-//!   Brent's root finder (argmin's `BrentRoot`).
+//!   at most 3 parameters the whole method is a dense 3 x 3 solve per step. It is a local
+//!   method: the global search ([`super::search`]) decides where it starts.
 //! - [`jacobian`]: central differences with a step matched to the accuracy of the model (see
 //!   [`Residuals::fd_step`]); one-sided at a bound.
 //! - [`covariance`]: (J^T J)^-1, the covariance of theta when the sigma_i are exact.
 //!
-//! **Needs** residuals that are finite inside the box; an `Err` from the model aborts the fit.
+//! **Needs** a finite start inside the box. A NaN residual is an error value (a model that
+//! returns NaN is broken); an infinite chi2 (errors so small that the squares overflow) makes a
+//! trial step fail, and at the start it ends the run unconverged. The iteration count is capped
+//! ([`LmOptions::max_iterations`]) and so is the damping (1e30): both end unconverged, with the
+//! reason.
 //!
 //! **Known answers**: the tests below fit an exponential decay (closed-form Jacobian not used) and
 //! a linear model whose least-squares solution and covariance are known in closed form.
 
 use crate::error::{Error, Result};
-use argmin::core::{CostFunction, Executor, State, TerminationReason};
-use argmin::solver::brent::{BrentOpt, BrentRoot};
 use nalgebra::{DMatrix, DVector};
-use std::cell::RefCell;
 
 /// A least-squares problem: residuals f_i(theta) and the box theta must stay in.
 pub trait Residuals {
@@ -45,10 +43,27 @@ pub trait Residuals {
     fn fd_step(&self) -> f64;
 }
 
-/// chi2 = sum f_i^2 at theta.
+fn nan_residual(theta: &[f64]) -> Error {
+    Error::InvalidParameter {
+        name: "model residual (NaN) at parameter",
+        value: theta.first().copied().unwrap_or(f64::NAN),
+        expected: "a model that evaluates to a number everywhere in the search box",
+    }
+}
+
+/// Residuals at theta, with NaN turned into an error value.
+pub fn residuals_checked(p: &impl Residuals, theta: &[f64], out: &mut [f64]) -> Result<()> {
+    p.residuals(theta, out)?;
+    if out.iter().any(|x| x.is_nan()) {
+        return Err(nan_residual(theta));
+    }
+    Ok(())
+}
+
+/// chi2 = sum f_i^2 at theta (+inf when the squares overflow; NaN residuals are an error).
 pub fn chi2(p: &impl Residuals, theta: &[f64]) -> Result<f64> {
     let mut f = vec![0.0; p.n_residuals()];
-    p.residuals(theta, &mut f)?;
+    residuals_checked(p, theta, &mut f)?;
     Ok(f.iter().map(|x| x * x).sum())
 }
 
@@ -74,19 +89,19 @@ pub fn jacobian(
         let (fplus, fminus, width): (&[f64], &[f64], f64) = match (up_ok, down_ok) {
             (true, true) => {
                 t[j] = theta[j] + h;
-                p.residuals(&t, &mut fp)?;
+                residuals_checked(p, &t, &mut fp)?;
                 t[j] = theta[j] - h;
-                p.residuals(&t, &mut fm)?;
+                residuals_checked(p, &t, &mut fm)?;
                 (&fp, &fm, 2.0 * h)
             }
             (true, false) => {
                 t[j] = theta[j] + h;
-                p.residuals(&t, &mut fp)?;
+                residuals_checked(p, &t, &mut fp)?;
                 (&fp, f0, h)
             }
             (false, true) => {
                 t[j] = theta[j] - h;
-                p.residuals(&t, &mut fm)?;
+                residuals_checked(p, &t, &mut fm)?;
                 (f0, &fm, h)
             }
             (false, false) => (f0, f0, 1.0),
@@ -114,7 +129,8 @@ pub struct Covariance {
 /// the rank test does not depend on units; eigenvalues below 1e-12 of the largest (columns
 /// parallel to 1 - 1e-12) are a null space, and a parameter with a share above 1e-6 in it is
 /// degenerate. For the others the pseudo-inverse gives their exact variance (they are estimable:
-/// orthogonal to the null space).
+/// orthogonal to the null space). A column with a non-finite norm (an overflowing Jacobian)
+/// counts as undetermined.
 pub fn covariance(jac: &DMatrix<f64>) -> Covariance {
     let p = jac.ncols();
     let mut out = Covariance {
@@ -123,10 +139,14 @@ pub fn covariance(jac: &DMatrix<f64>) -> Covariance {
         degenerate: vec![false; p],
     };
     let norms: Vec<f64> = (0..p).map(|j| jac.column(j).norm()).collect();
-    let live: Vec<usize> = (0..p).filter(|&j| norms[j] > 0.0).collect();
-    for (flag, &norm) in out.no_effect.iter_mut().zip(&norms) {
-        // Also true for a NaN norm: such a column carries no usable information either.
-        *flag = norm.is_nan() || norm <= 0.0;
+    let live: Vec<usize> = (0..p)
+        .filter(|&j| norms[j].is_finite() && norms[j] > 0.0)
+        .collect();
+    for (j, &norm) in norms.iter().enumerate() {
+        out.no_effect[j] = !(norm > 0.0);
+        if norm.is_infinite() {
+            out.degenerate[j] = true;
+        }
     }
     if live.is_empty() {
         return out;
@@ -210,17 +230,21 @@ pub fn levenberg_marquardt(
 ) -> Result<LmOutcome> {
     let n = p.n_residuals();
     let (lo, hi) = (p.lower(), p.upper());
+    if let Some(j) = (0..start.len()).find(|&j| !start[j].is_finite()) {
+        return Err(Error::InvalidParameter {
+            name: "Levenberg-Marquardt start value",
+            value: start[j],
+            expected: "a finite number",
+        });
+    }
     let mut theta: Vec<f64> = start
         .iter()
         .enumerate()
         .map(|(j, &t)| t.clamp(lo[j], hi[j]))
         .collect();
     let mut f = vec![0.0; n];
-    p.residuals(&theta, &mut f)?;
+    residuals_checked(p, &theta, &mut f)?;
     let mut chi2v: f64 = f.iter().map(|x| x * x).sum();
-    let mut mu = 1e-3;
-    let mut nu = 2.0;
-    let mut f_new = vec![0.0; n];
     let outcome = |theta: Vec<f64>, chi2: f64, it: usize, conv: bool, reason| LmOutcome {
         theta,
         chi2,
@@ -228,9 +252,15 @@ pub fn levenberg_marquardt(
         converged: conv,
         reason,
     };
+    if !chi2v.is_finite() {
+        return Ok(outcome(theta, chi2v, 0, false, "chi2 not finite at the start"));
+    }
     if !free.iter().any(|&b| b) {
         return Ok(outcome(theta, chi2v, 0, true, "no free parameters"));
     }
+    let mut mu = 1e-3;
+    let mut nu = 2.0;
+    let mut f_new = vec![0.0; n];
     let mut need_jac = true;
     let mut jac = DMatrix::zeros(0, 0);
     let mut free_now: Vec<bool> = free.to_vec();
@@ -239,6 +269,9 @@ pub fn levenberg_marquardt(
         if need_jac {
             // Active set: a parameter on a bound whose descent direction leaves the box is held.
             let all = jacobian(p, &theta, free, &f)?;
+            if all.iter().any(|x| !x.is_finite()) {
+                return Ok(outcome(theta, chi2v, it, false, "Jacobian not finite"));
+            }
             let fv = DVector::from_column_slice(&f);
             let g_all = all.transpose() * &fv;
             let cols: Vec<usize> = (0..theta.len()).filter(|&j| free[j]).collect();
@@ -253,6 +286,9 @@ pub fn levenberg_marquardt(
                 if free_now[j] && cn > 0.0 && fnorm > 0.0 {
                     worst = worst.max(g_all[c].abs() / (cn * fnorm));
                 }
+            }
+            if !worst.is_finite() {
+                return Ok(outcome(theta, chi2v, it, false, "gradient not finite"));
             }
             if worst <= opts.gtol {
                 return Ok(outcome(
@@ -285,12 +321,16 @@ pub fn levenberg_marquardt(
         }
         let h = match lhs.cholesky() {
             Some(ch) => ch.solve(&(-&g)),
-            None => {
-                mu *= nu;
-                nu *= 2.0;
-                continue;
-            }
+            None => DVector::from_element(m, f64::NAN),
         };
+        if h.iter().any(|x| !x.is_finite()) {
+            mu *= nu;
+            nu *= 2.0;
+            if !(mu <= 1e30) {
+                return Ok(outcome(theta, chi2v, it, false, "damping overflow"));
+            }
+            continue;
+        }
         let mut trial = theta.clone();
         for (k, &j) in idx.iter().enumerate() {
             trial[j] = (theta[j] + h[k]).clamp(lo[j], hi[j]);
@@ -301,7 +341,7 @@ pub fn levenberg_marquardt(
             .all(|&j| (trial[j] - theta[j]).abs() <= opts.xtol * (theta[j].abs() + opts.xtol));
         // Predicted decrease of chi2 for the (projected) step, from the Gauss-Newton model.
         let pred = -(2.0 * g.dot(&step) + (&a * &step).dot(&step));
-        p.residuals(&trial, &mut f_new)?;
+        residuals_checked(p, &trial, &mut f_new)?;
         let chi2_new: f64 = f_new.iter().map(|x| x * x).sum();
         let actual = chi2v - chi2_new;
         if chi2_new.is_finite() && actual > 0.0 && pred > 0.0 {
@@ -323,6 +363,7 @@ pub fn levenberg_marquardt(
                 ));
             }
         } else {
+            // `pred` is finite here: the step h and the matrix a are.
             if small_step || pred <= opts.ftol * chi2v.max(1e-300) {
                 return Ok(outcome(
                     theta,
@@ -334,7 +375,7 @@ pub fn levenberg_marquardt(
             }
             mu *= nu;
             nu *= 2.0;
-            if !mu.is_finite() || mu > 1e30 {
+            if !(mu <= 1e30) {
                 return Ok(outcome(theta, chi2v, it, false, "damping overflow"));
             }
         }
@@ -346,145 +387,6 @@ pub fn levenberg_marquardt(
         false,
         "maximum number of iterations",
     ))
-}
-
-/// A scalar function for argmin's Brent solvers; model errors are kept aside and re-raised.
-struct Scalar<'a, F: FnMut(f64) -> Result<f64>> {
-    f: RefCell<F>,
-    failure: &'a RefCell<Option<Error>>,
-    offset: f64,
-}
-
-impl<F: FnMut(f64) -> Result<f64>> CostFunction for Scalar<'_, F> {
-    type Param = f64;
-    type Output = f64;
-    fn cost(&self, x: &f64) -> std::result::Result<f64, argmin::core::Error> {
-        match (self.f.borrow_mut())(*x) {
-            Ok(v) => Ok(v - self.offset),
-            Err(e) => {
-                *self.failure.borrow_mut() = Some(e.clone());
-                Err(e.into())
-            }
-        }
-    }
-}
-
-/// The model's own error if it raised one, else the solver's complaint (a bracket without a sign
-/// change, which the callers rule out).
-fn solver_failure(what: &'static str, kept: Option<Error>) -> Error {
-    kept.unwrap_or(Error::InvalidParameter {
-        name: what,
-        value: f64::NAN,
-        expected: "a bracket with a sign change",
-    })
-}
-
-/// Minimum of f on [a, b] by Brent's method (argmin `BrentOpt`), to |x| 1.5e-8 + `abs_tol`.
-/// Returns (x, f(x), converged). The bracket must contain the minimum the caller wants: Brent
-/// finds a local minimum inside it.
-pub fn brent_minimize(
-    f: impl FnMut(f64) -> Result<f64>,
-    a: f64,
-    b: f64,
-    abs_tol: f64,
-) -> Result<(f64, f64, bool)> {
-    let failure = RefCell::new(None);
-    let problem = Scalar {
-        f: RefCell::new(f),
-        failure: &failure,
-        offset: 0.0,
-    };
-    let solver = BrentOpt::new(a, b).set_tolerance(f64::EPSILON.sqrt(), abs_tol);
-    let res = Executor::new(problem, solver)
-        .configure(|s| s.max_iters(200))
-        .run();
-    match res {
-        Ok(r) => {
-            let st = r.state();
-            let x = *st.get_best_param().unwrap_or(&f64::NAN);
-            let converged = matches!(
-                st.get_termination_reason(),
-                Some(TerminationReason::SolverConverged)
-            );
-            Ok((x, st.get_best_cost(), converged))
-        }
-        Err(_) => Err(solver_failure("Brent minimisation", failure.take())),
-    }
-}
-
-/// The point between `t_hat` and `limit` where `profile(t)` first reaches `threshold`, or `None`
-/// when it stays below up to `limit` (the interval is open on that side).
-///
-/// `profile(t_hat)` must be below `threshold`. Trial points go out from `t_hat` by `step`,
-/// doubling, until the profile exceeds the threshold or `limit` is reached; then argmin's
-/// `BrentRoot` finds the crossing to `tol` in t.
-pub fn profile_crossing(
-    mut profile: impl FnMut(f64) -> Result<f64>,
-    t_hat: f64,
-    limit: f64,
-    step: f64,
-    threshold: f64,
-    tol: f64,
-) -> Result<Option<f64>> {
-    let dir = (limit - t_hat).signum();
-    if dir == 0.0 {
-        return Ok(None);
-    }
-    let mut inner = t_hat;
-    let mut dist = step.abs().max(tol);
-    let outer = loop {
-        let t = if (t_hat + dir * dist - limit) * dir >= 0.0 {
-            limit
-        } else {
-            t_hat + dir * dist
-        };
-        let v = profile(t)?;
-        if v >= threshold {
-            break t;
-        }
-        if t == limit {
-            return Ok(None);
-        }
-        inner = t;
-        dist *= 2.0;
-    };
-    let failure = RefCell::new(None);
-    let shared = RefCell::new(&mut profile);
-    let problem = Scalar {
-        f: RefCell::new(|t: f64| (shared.borrow_mut())(t)),
-        failure: &failure,
-        offset: threshold,
-    };
-    let (a, b) = if inner < outer {
-        (inner, outer)
-    } else {
-        (outer, inner)
-    };
-    let res = Executor::new(problem, BrentRoot::new(a, b, tol))
-        .configure(|s| s.max_iters(100))
-        .run();
-    match res {
-        Ok(r) => Ok(r.state().get_best_param().copied().or(Some(outer))),
-        Err(_) => {
-            if let Some(e) = failure.take() {
-                return Err(e);
-            }
-            // A profile that re-minimises the other parameters need not return the same value
-            // when evaluated again at a bracket end (its inner minimisation may settle
-            // elsewhere), so Brent can find no sign change. Bisect instead, trusting the
-            // classification of each new point.
-            let (mut below, mut above) = (inner, outer);
-            while (above - below).abs() > tol {
-                let mid = 0.5 * (below + above);
-                if (shared.borrow_mut())(mid)? >= threshold {
-                    above = mid;
-                } else {
-                    below = mid;
-                }
-            }
-            Ok(Some(0.5 * (below + above)))
-        }
-    }
 }
 
 #[cfg(test)]
@@ -605,30 +507,36 @@ mod tests {
     }
 
     #[test]
-    fn brent_minimum_and_profile_crossing() {
-        // (x - 2)^2 + 1: minimum 1 at 2; crossing of 1 + 3.84 at 2 +- sqrt(3.84).
-        let (x, fx, conv) =
-            brent_minimize(|x| Ok((x - 2.0).powi(2) + 1.0), -5.0, 10.0, 1e-12).unwrap();
-        assert!(conv && (x - 2.0).abs() < 1e-7 && (fx - 1.0).abs() < 1e-13);
-        let f = |x: f64| Ok((x - 2.0f64).powi(2) + 1.0);
-        let up = profile_crossing(f, 2.0, 100.0, 0.5, 4.84, 1e-10)
-            .unwrap()
-            .unwrap();
-        assert!((up - (2.0 + 3.84f64.sqrt())).abs() < 1e-9, "{up}");
-        let down = profile_crossing(f, 2.0, -100.0, 0.5, 4.84, 1e-10)
-            .unwrap()
-            .unwrap();
-        assert!((down - (2.0 - 3.84f64.sqrt())).abs() < 1e-9, "{down}");
-        // A plateau: never reaches the threshold before the limit.
-        let flat = |x: f64| Ok(if x < 2.0 { (x - 2.0f64).powi(2) } else { 0.0 });
-        assert_eq!(
-            profile_crossing(flat, 2.0, 50.0, 0.5, 3.84, 1e-10).unwrap(),
-            None
-        );
-        assert!(
-            profile_crossing(flat, 2.0, -50.0, 0.5, 3.84, 1e-10)
-                .unwrap()
-                .is_some()
-        );
+    fn lm_failures_are_values_not_hangs() {
+        let x: Vec<f64> = (0..20).map(|i| i as f64 * 0.25).collect();
+        let y: Vec<f64> = x.iter().map(|&x| 3.0 * (-0.7 * x).exp()).collect();
+        let p = Decay {
+            x: x.clone(),
+            y: y.clone(),
+            lo: vec![-100.0, -100.0],
+            hi: vec![100.0, 100.0],
+        };
+        // The iteration cap ends the run unconverged, with the reason.
+        let one = LmOptions {
+            max_iterations: 1,
+            ..LmOptions::default()
+        };
+        let r = levenberg_marquardt(&p, &[1.0, 3.0], &[true, true], &one).unwrap();
+        assert!(!r.converged && r.reason == "maximum number of iterations", "{r:?}");
+        // A non-finite start is an error; so is a model returning NaN.
+        assert!(levenberg_marquardt(&p, &[f64::NAN, 3.0], &[true, true], &one).is_err());
+        let mut bad = Decay {
+            x,
+            y,
+            lo: vec![-100.0, -100.0],
+            hi: vec![100.0, 100.0],
+        };
+        bad.y[3] = f64::NAN;
+        let opts = LmOptions::default();
+        assert!(levenberg_marquardt(&bad, &[1.0, 3.0], &[true, true], &opts).is_err());
+        // Residuals whose squares overflow: unconverged at the start, not a wrong minimum.
+        bad.y[3] = 1e200;
+        let r = levenberg_marquardt(&bad, &[1.0, 3.0], &[true, true], &opts).unwrap();
+        assert!(!r.converged && r.chi2.is_infinite(), "{r:?}");
     }
 }

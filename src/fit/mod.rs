@@ -1,15 +1,25 @@
-//! Fitting measured coefficients of restitution: models, least squares, comparison, reports.
+//! Fitting measured coefficients of restitution: models, least squares, a certified global
+//! search, uncertainties, comparison, reports.
 
+pub mod bnb;
 pub mod compare;
 pub mod dataset;
 pub mod engine;
 pub mod input;
+pub mod landscape;
 pub mod lsq;
 pub mod models;
+pub mod objective;
+pub mod profile;
 pub mod report;
+pub mod report_text;
+pub mod result;
+pub mod scalar;
+pub mod search;
 pub mod walton;
 
 pub use compare::{Comparison, ComparisonRow, compare};
 pub use dataset::{FitData, Group, Observation};
-pub use engine::{FitOptions, FitResult, FitSet, ParamEstimate, ParamStatus, fit, fit_all};
+pub use engine::{FitOptions, FitSet, fit, fit_all};
 pub use models::ModelKind;
+pub use result::{FitResult, GlobalSearch, ParamEstimate, ParamStatus};

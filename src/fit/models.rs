@@ -226,7 +226,10 @@ pub struct Evaluator<'a> {
     kappa_per_eta: Vec<f64>,
     /// V_Y at sigma_y = 1 Pa: V_Y ~ sigma_y^(5/2) (Eq. 15, [`Contact::yield_velocity_m_s`]).
     v_yield_per_pa: Vec<f64>,
-    powerlaw_d_mm: Vec<f64>,
+    /// ln(d/d_ref) and ln(v/v_ref) of the power law: 1 - e = exp(ln A - a x1 + b x2), one
+    /// exp per point instead of two powf.
+    powerlaw_ln_d: Vec<f64>,
+    powerlaw_ln_v: Vec<f64>,
 }
 
 impl<'a> Evaluator<'a> {
@@ -242,7 +245,16 @@ impl<'a> Evaluator<'a> {
                 .iter()
                 .map(|c| c.yield_velocity_m_s(1.0))
                 .collect(),
-            powerlaw_d_mm: data.contacts.iter().map(powerlaw_d_mm).collect(),
+            powerlaw_ln_d: data
+                .contacts
+                .iter()
+                .map(|c| (powerlaw_d_mm(c) / POWERLAW_D_REF_MM).ln())
+                .collect(),
+            powerlaw_ln_v: data
+                .obs
+                .iter()
+                .map(|o| (o.v_n_m_s / POWERLAW_V_REF_M_S).ln())
+                .collect(),
         }
     }
 
@@ -282,21 +294,37 @@ impl<'a> Evaluator<'a> {
         plastic::rebound_u(self.data.obs[i].v_n_m_s / self.v_yield_m_s(i, sigma_y_pa)).e
     }
 
+    /// e_pm of point `i` given sigma_y^(5/2) (computed once for all points).
+    fn e_pm_s25(&self, i: usize, s25: f64) -> f64 {
+        plastic::rebound_u(self.data.obs[i].v_n_m_s / (self.v_yield_per_pa[i] * s25)).e
+    }
+
+    /// e_pm of every point at sigma_y, into `out`.
+    pub fn e_pm_row(&self, sigma_y_pa: f64, out: &mut [f64]) {
+        let s25 = sigma_y_pa.powf(2.5);
+        for (i, o) in out.iter_mut().enumerate().take(self.len()) {
+            *o = self.e_pm_s25(i, s25);
+        }
+    }
+
     /// Model e at every point for physical parameters `p` (order of [`ModelKind::params`]).
     pub fn predict(&self, kind: ModelKind, p: &[f64], out: &mut [f64]) -> Result<()> {
+        let s25 = match kind {
+            ModelKind::Pm => p[0].powf(2.5),
+            ModelKind::Min | ModelKind::Product => p[1].powf(2.5),
+            _ => f64::NAN,
+        };
         for (i, slot) in out.iter_mut().enumerate().take(self.len()) {
             *slot = match kind {
                 ModelKind::Vm => self.e_vm(i, p[0])?,
-                ModelKind::Pm => self.e_pm(i, p[0]),
-                ModelKind::Min => self.e_vm(i, p[0])?.min(self.e_pm(i, p[1])),
-                ModelKind::Product => self.e_vm(i, p[0])? * self.e_pm(i, p[1]),
-                ModelKind::PowerLaw => e_powerlaw(
-                    self.powerlaw_d_mm[i],
-                    self.data.obs[i].v_n_m_s,
-                    p[0],
-                    p[1],
-                    p[2],
-                ),
+                ModelKind::Pm => self.e_pm_s25(i, s25),
+                ModelKind::Min => self.e_vm(i, p[0])?.min(self.e_pm_s25(i, s25)),
+                ModelKind::Product => self.e_vm(i, p[0])? * self.e_pm_s25(i, s25),
+                ModelKind::PowerLaw => {
+                    1.0 - (p[0].ln() - p[1] * self.powerlaw_ln_d[i]
+                        + p[2] * self.powerlaw_ln_v[i])
+                        .exp()
+                }
             };
         }
         Ok(())

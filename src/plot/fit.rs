@@ -2,7 +2,8 @@
 //! `residuals.svg` (normalised residuals of every fitted model).
 
 use crate::fit::dataset::{FitData, Group};
-use crate::fit::engine::{FitResult, FitSet};
+use crate::fit::engine::FitSet;
+use crate::fit::result::FitResult;
 use crate::fit::models::{ModelKind, predict_e};
 use crate::models::viscoelastic::{ContactEnd, VmMethod};
 use plotters::coord::CoordTranslate;

@@ -1,0 +1,710 @@
+//! Branch and bound over a box of one or two dimensions, for the global search of the fit.
+//!
+//! **Solves**: certifies that no point of a box has chi2 below a known value U minus a tolerance
+//! tau, or finds the cells where it might. **Needs** a [`Landscape`]: chi2 at grid nodes and, for
+//! any cell between nodes, a lower bound of chi2 over the whole cell (for the fit's models these
+//! come from monotonicity, see [`super::search`]). **Method**: the classic branch and bound
+//! (Horst & Tuy, "Global Optimization: Deterministic Approaches", 3rd ed., 1996, ch. IV): a cell
+//! whose bound exceeds U - tau is done (it cannot hold a point lower than U - tau); the others
+//! are split, lowest bound first, until none is left or a budget runs out. Cells lie on a dyadic
+//! grid (up to 40 halvings of a uniform starting grid), so their corners are shared and each
+//! grid value of an axis is tabulated once.
+//!
+//! The caller lowers U as it finds better points (local polishes from the candidates this module
+//! proposes) and refines again; the certificate is then min(bound over the remaining cells),
+//! whatever the polishes did.
+//!
+//! **Known answer** (test below): a separable two-minimum function whose bounds are exact on
+//! every cell is certified to the tolerance, both minima are proposed, and a cell budget of 1
+//! ends unresolved.
+
+use std::cmp::Ordering;
+use std::collections::{BinaryHeap, HashMap, HashSet};
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// A small hasher for the integer keys of the grid (std's SipHash costs more than the work it
+/// indexes): words folded by multiplication, finished by splitmix64's mixer so that dyadic
+/// positions (low bits zero) spread over the table.
+#[derive(Default, Clone, Copy)]
+struct Mix(u64);
+
+impl Hasher for Mix {
+    fn finish(&self) -> u64 {
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+    fn write_u64(&mut self, x: u64) {
+        self.0 = (self.0.rotate_left(23) ^ x).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    }
+    fn write_usize(&mut self, x: usize) {
+        self.write_u64(x as u64);
+    }
+}
+
+type Map<K, V> = HashMap<K, V, BuildHasherDefault<Mix>>;
+
+/// Halvings of the starting cells allowed.
+pub const DEPTH: u32 = 40;
+
+/// The function a [`Bnb`] works on.
+pub trait Landscape {
+    /// Tabulates axis `axis` at internal coordinate `t`; row ids are assigned in call order per
+    /// axis, and a row must be appended even when it fails (the error text is returned).
+    fn add_row(&mut self, axis: usize, t: f64) -> Result<(), String>;
+    /// chi2 at the node of rows `r` (+inf allowed; NaN only when a row failed).
+    fn node(&self, r: [usize; 2]) -> f64;
+    /// A lower bound of chi2 over the cell between rows `lo` (lower coordinate) and `hi` on each
+    /// axis, and how much of its looseness each axis causes (to choose the axis to split). Only
+    /// its position relative to `target` matters: an iterative bound may stop once that is
+    /// decided.
+    fn bound(&self, lo: [usize; 2], hi: [usize; 2], target: f64) -> Bound;
+}
+
+/// A cell's lower bound and the looseness per axis.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bound {
+    pub lb: f64,
+    pub loose: [f64; 2],
+}
+
+/// One axis of the box: its range, starting cells, and the rows tabulated so far.
+struct Axis {
+    lo: f64,
+    hi: f64,
+    n0: u64,
+    active: bool,
+    row_of: Map<u64, usize>,
+    t: Vec<f64>,
+    ok: Vec<bool>,
+}
+
+impl Axis {
+    fn span(&self) -> u64 {
+        if self.active { self.n0 << DEPTH } else { 0 }
+    }
+    fn t_at(&self, p: u64) -> f64 {
+        if !self.active {
+            self.lo
+        } else if p == self.span() {
+            self.hi
+        } else {
+            self.lo + (self.hi - self.lo) * (p as f64 / self.span() as f64)
+        }
+    }
+}
+
+/// A cell: dyadic positions of its lower and upper corners.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Cell {
+    p0: [u64; 2],
+    p1: [u64; 2],
+    bound: Bound,
+    failed: bool,
+}
+
+struct ByBound(Cell);
+impl PartialEq for ByBound {
+    fn eq(&self, o: &Self) -> bool {
+        self.cmp(o) == Ordering::Equal
+    }
+}
+impl Eq for ByBound {}
+impl PartialOrd for ByBound {
+    fn partial_cmp(&self, o: &Self) -> Option<Ordering> {
+        Some(self.cmp(o))
+    }
+}
+impl Ord for ByBound {
+    /// Reversed: the max-heap pops the lowest bound first.
+    fn cmp(&self, o: &Self) -> Ordering {
+        o.0.bound.lb.total_cmp(&self.0.bound.lb)
+    }
+}
+
+/// A point proposed for a local polish: a node that is a local minimum of the grid at the scale
+/// of the cell it belongs to, with its neighbours' coordinates as a bracket.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Candidate {
+    pub t: [f64; 2],
+    pub rows: [usize; 2],
+    pub chi2: f64,
+    pub bracket_lo: [f64; 2],
+    pub bracket_hi: [f64; 2],
+    /// The lower bound of the cell it came from: a polish from here cannot beat this.
+    pub lb: f64,
+}
+
+/// What splitting a cell gave.
+enum Split {
+    Cells(Vec<Cell>),
+    /// Every axis that matters is at the statistical resolution.
+    Fine,
+    /// An axis that matters cannot be halved again on the dyadic grid.
+    Finest,
+}
+
+/// Budgets of a [`Bnb`].
+#[derive(Debug, Clone, Copy)]
+pub struct Limits {
+    pub max_cells: u64,
+    pub max_rows: usize,
+}
+
+/// The branch and bound state (see the module doc).
+pub struct Bnb<L: Landscape> {
+    pub land: L,
+    axes: [Axis; 2],
+    nodes: Map<[usize; 2], f64>,
+    /// Lowest node so far: positions and chi2.
+    best: Option<([u64; 2], f64)>,
+    heap: BinaryHeap<ByBound>,
+    /// Cells not split further: bound at or above U - tau when last looked at.
+    done: Vec<Cell>,
+    /// Cells that could not be resolved, with the reason.
+    unresolved: Vec<(Cell, String)>,
+    /// Cells left at the statistical resolution ([`Bnb::set_resolution`]) with a bound below
+    /// U - tau: they surround the minima, where local polishes take over.
+    fine: Vec<Cell>,
+    /// Widths below which an axis is not split (internal units; 0 = down to the dyadic grid).
+    resolution: [f64; 2],
+    /// Starting grid, for [`Bnb::initial_minima`].
+    start_cells: Vec<Cell>,
+    pub cells: u64,
+    limits: Limits,
+    /// Whether [`Bnb::refine`] has taken the starting cells yet.
+    started: bool,
+    /// U - tau at the last look (what a cell bound is compared with).
+    target: f64,
+    /// Rows that could not be evaluated (reason, first few).
+    pub row_failures: Vec<String>,
+}
+
+impl<L: Landscape> Bnb<L> {
+    /// A uniform starting grid of `n0[k]` cells over `range[k]` (an axis with `n0 = 0` is
+    /// inactive: one row at its `lo`). Evaluates every starting node and cell bound.
+    pub fn new(land: L, range: [(f64, f64); 2], n0: [u64; 2], limits: Limits) -> Self {
+        let axis = |k: usize| Axis {
+            lo: range[k].0,
+            hi: range[k].1,
+            n0: n0[k].max(1),
+            active: n0[k] > 0,
+            row_of: Map::default(),
+            t: Vec::new(),
+            ok: Vec::new(),
+        };
+        let mut b = Bnb {
+            land,
+            axes: [axis(0), axis(1)],
+            nodes: Map::default(),
+            best: None,
+            heap: BinaryHeap::new(),
+            done: Vec::new(),
+            unresolved: Vec::new(),
+            fine: Vec::new(),
+            resolution: [0.0, 0.0],
+            start_cells: Vec::new(),
+            cells: 0,
+            limits,
+            started: false,
+            target: f64::INFINITY,
+            row_failures: Vec::new(),
+        };
+        let step = |k: usize, b: &Self| if b.axes[k].active { 1u64 << DEPTH } else { 0 };
+        let (s0, s1) = (step(0, &b), step(1, &b));
+        let (c0, c1) = (
+            if b.axes[0].active { n0[0] } else { 1 },
+            if b.axes[1].active { n0[1] } else { 1 },
+        );
+        // Nodes first: the best of them is the target the starting cells' bounds are judged by.
+        for i in 0..=c0 {
+            for j in 0..=c1 {
+                b.node_at([i * s0, j * s1]);
+            }
+        }
+        b.target = b.best.map_or(f64::INFINITY, |(_, v)| v);
+        for i in 0..c0 {
+            for j in 0..c1 {
+                let cell = b.make_cell([i * s0, j * s1], [(i + 1) * s0, (j + 1) * s1]);
+                b.start_cells.push(cell);
+            }
+        }
+        b
+    }
+
+    fn row(&mut self, k: usize, p: u64) -> usize {
+        if let Some(&r) = self.axes[k].row_of.get(&p) {
+            return r;
+        }
+        let t = self.axes[k].t_at(p);
+        let ok = match self.land.add_row(k, t) {
+            Ok(()) => true,
+            Err(why) => {
+                if self.row_failures.len() < 3 {
+                    self.row_failures.push(why);
+                }
+                false
+            }
+        };
+        let a = &mut self.axes[k];
+        let r = a.t.len();
+        a.t.push(t);
+        a.ok.push(ok);
+        a.row_of.insert(p, r);
+        r
+    }
+
+    fn rows_total(&self) -> usize {
+        self.axes[0].t.len() + self.axes[1].t.len()
+    }
+
+    fn node_at(&mut self, p: [u64; 2]) -> (f64, [usize; 2]) {
+        let r = [self.row(0, p[0]), self.row(1, p[1])];
+        if let Some(&v) = self.nodes.get(&r) {
+            return (v, r);
+        }
+        let ok = self.axes[0].ok[r[0]] && self.axes[1].ok[r[1]];
+        let v = if ok { self.land.node(r) } else { f64::NAN };
+        self.nodes.insert(r, v);
+        if !v.is_nan() && self.best.is_none_or(|(_, b)| v < b) {
+            self.best = Some((p, v));
+        }
+        (v, r)
+    }
+
+    fn make_cell(&mut self, p0: [u64; 2], p1: [u64; 2]) -> Cell {
+        self.cells += 1;
+        for p in [p0, [p1[0], p0[1]], [p0[0], p1[1]], p1] {
+            self.node_at(p);
+        }
+        let lo = [self.row(0, p0[0]), self.row(1, p0[1])];
+        let hi = [self.row(0, p1[0]), self.row(1, p1[1])];
+        let ok = lo.iter().chain(&hi).enumerate().all(|(n, &r)| self.axes[n % 2].ok[r]);
+        let target = self.target;
+        let mut bound = if ok {
+            self.land.bound(lo, hi, target)
+        } else {
+            Bound {
+                lb: f64::NEG_INFINITY,
+                loose: [1.0, 1.0],
+            }
+        };
+        let failed = !ok || bound.lb.is_nan();
+        if bound.lb.is_nan() {
+            bound.lb = f64::NEG_INFINITY;
+        }
+        Cell {
+            p0,
+            p1,
+            bound,
+            failed,
+        }
+    }
+
+    /// The lowest node evaluated so far: rows, internal coordinates and chi2.
+    pub fn best_node(&self) -> Option<([usize; 2], [f64; 2], f64)> {
+        let (p, v) = self.best?;
+        let r = [self.axes[0].row_of[&p[0]], self.axes[1].row_of[&p[1]]];
+        Some((r, self.t_of(r), v))
+    }
+
+    /// Internal coordinates of rows.
+    pub fn t_of(&self, rows: [usize; 2]) -> [f64; 2] {
+        [self.axes[0].t[rows[0]], self.axes[1].t[rows[1]]]
+    }
+
+    /// Every evaluated node with chi2 at most `below`: rows, internal coordinates and chi2.
+    pub fn nodes_below(&self, below: f64) -> Vec<([usize; 2], [f64; 2], f64)> {
+        self.nodes
+            .iter()
+            .filter(|(_, v)| **v <= below)
+            .map(|(r, v)| (*r, self.t_of(*r), *v))
+            .collect()
+    }
+
+    /// Local minima of the starting grid (a node not above any of its 8 neighbours, ties broken
+    /// by position) that could still lead below `upper - tau` (a cell touching them has a bound
+    /// below it), lowest first.
+    pub fn initial_minima(&mut self, upper: f64, tau: f64) -> Vec<Candidate> {
+        let act = [self.axes[0].active, self.axes[1].active];
+        let n = [
+            if act[0] { self.axes[0].n0 } else { 0 },
+            if act[1] { self.axes[1].n0 } else { 0 },
+        ];
+        let step = [1u64 << DEPTH, 1u64 << DEPTH];
+        let mut out = Vec::new();
+        for i in 0..=n[0] {
+            for j in 0..=n[1] {
+                let p = [i * step[0] * act[0] as u64, j * step[1] * act[1] as u64];
+                let (v, r) = self.node_at(p);
+                if !v.is_finite() {
+                    continue;
+                }
+                let mut is_min = true;
+                let mut touching_lb = f64::INFINITY;
+                for di in -1i64..=1 {
+                    for dj in -1i64..=1 {
+                        let (ii, jj) = (i as i64 + di, j as i64 + dj);
+                        if (di, dj) == (0, 0)
+                            || ii < 0
+                            || jj < 0
+                            || ii > n[0] as i64
+                            || jj > n[1] as i64
+                        {
+                            continue;
+                        }
+                        let q = [
+                            ii as u64 * step[0] * act[0] as u64,
+                            jj as u64 * step[1] * act[1] as u64,
+                        ];
+                        let (w, _) = self.node_at(q);
+                        let lower = w < v || (w == v && (q[0], q[1]) < (p[0], p[1]));
+                        if lower {
+                            is_min = false;
+                        }
+                    }
+                }
+                if !is_min {
+                    continue;
+                }
+                for c in &self.start_cells {
+                    let inside = (0..2).all(|k| c.p0[k] <= p[k] && p[k] <= c.p1[k]);
+                    if inside {
+                        touching_lb = touching_lb.min(c.bound.lb);
+                    }
+                }
+                if touching_lb < upper - tau || v < upper {
+                    out.push(self.candidate(p, r, v, [step[0], step[1]], touching_lb));
+                }
+            }
+        }
+        out.sort_by(|a, b| a.chi2.total_cmp(&b.chi2));
+        out
+    }
+
+    fn candidate(&self, p: [u64; 2], r: [usize; 2], v: f64, w: [u64; 2], lb: f64) -> Candidate {
+        let mut lo = [0.0; 2];
+        let mut hi = [0.0; 2];
+        for k in 0..2 {
+            let a = &self.axes[k];
+            lo[k] = a.t_at(p[k].saturating_sub(w[k]));
+            hi[k] = a.t_at((p[k] + w[k]).min(a.span()));
+        }
+        Candidate {
+            t: self.t_of(r),
+            rows: r,
+            chi2: v,
+            bracket_lo: lo,
+            bracket_hi: hi,
+            lb,
+        }
+    }
+
+    /// Sets the widths below which an axis is not split any more (see the module doc).
+    pub fn set_resolution(&mut self, w: [f64; 2]) {
+        self.resolution = w;
+    }
+
+    /// The best node as a candidate, bracketed by its neighbours 1/1024 of a starting cell away.
+    pub fn best_candidate(&mut self) -> Option<Candidate> {
+        let (p, v) = self.best?;
+        let r = [self.row(0, p[0]), self.row(1, p[1])];
+        let w = [
+            if self.axes[0].active { 1u64 << (DEPTH - 10) } else { 0 },
+            if self.axes[1].active { 1u64 << (DEPTH - 10) } else { 0 },
+        ];
+        Some(self.candidate(p, r, v, w, f64::NEG_INFINITY))
+    }
+
+    /// Splits cells until every remaining one has a bound of at least U - tau, with U the lower
+    /// of `upper` and the best node so far (tau recomputed from U by `tau_of`), or is at the
+    /// resolution, or the budget runs out.
+    pub fn refine(&mut self, upper: f64, tau_of: &dyn Fn(f64) -> f64) {
+        let pending: Vec<Cell> = if self.started {
+            std::mem::take(&mut self.done)
+        } else {
+            self.started = true;
+            self.start_cells.clone()
+        };
+        let u_of = |s: &Self| s.best.map_or(upper, |(_, b)| b.min(upper));
+        for c in pending {
+            self.push(c, u_of(self), tau_of);
+        }
+        while let Some(ByBound(cell)) = self.heap.pop() {
+            let u = u_of(self);
+            let tau = tau_of(u);
+            self.target = u - tau;
+            if cell.bound.lb >= u - tau {
+                self.done.push(cell);
+                continue;
+            }
+            if self.cells >= self.limits.max_cells || self.rows_total() >= self.limits.max_rows {
+                self.unresolved
+                    .push((cell, "the search budget ran out".to_string()));
+                continue;
+            }
+            let children = match self.split(&cell) {
+                Split::Cells(c) => c,
+                Split::Fine => {
+                    self.fine.push(cell);
+                    continue;
+                }
+                Split::Finest => {
+                    self.unresolved
+                        .push((cell, "a cell reached the finest dyadic resolution".to_string()));
+                    continue;
+                }
+            };
+            for c in children {
+                self.push(c, u_of(self), tau_of);
+            }
+        }
+    }
+
+    fn push(&mut self, c: Cell, u: f64, tau_of: &dyn Fn(f64) -> f64) {
+        if c.failed {
+            let why = self
+                .row_failures
+                .first()
+                .cloned()
+                .unwrap_or_else(|| "the lower bound is not a number".into());
+            self.unresolved
+                .push((c, format!("the model could not be evaluated: {why}")));
+        } else if c.bound.lb < u - tau_of(u) {
+            self.heap.push(ByBound(c));
+        } else if c.bound.lb <= u {
+            self.done.push(c);
+        }
+    }
+
+    fn split(&mut self, c: &Cell) -> Split {
+        let width = |k: usize| self.axes[k].t_at(c.p1[k]) - self.axes[k].t_at(c.p0[k]);
+        let coarse = |k: usize| self.axes[k].active && width(k) > self.resolution[k];
+        let l = c.bound.loose;
+        let lmax = (0..2)
+            .filter(|&k| self.axes[k].active)
+            .map(|k| l[k])
+            .fold(0.0, f64::max);
+        // Split the coarse axes that carry the looseness (both when comparable); when the
+        // looseness sits on axes already at the resolution, splitting others cannot help.
+        let pick: Vec<usize> = (0..2)
+            .filter(|&k| coarse(k) && (!(lmax > 0.0) || l[k] >= 0.5 * lmax))
+            .collect();
+        if pick.is_empty() {
+            return Split::Fine;
+        }
+        let dyadic: Vec<usize> = pick
+            .into_iter()
+            .filter(|&k| c.p1[k] - c.p0[k] >= 2)
+            .collect();
+        if dyadic.is_empty() {
+            return Split::Finest;
+        }
+        let cuts = |k: usize| -> Vec<(u64, u64)> {
+            if dyadic.contains(&k) {
+                let m = c.p0[k] + (c.p1[k] - c.p0[k]) / 2;
+                vec![(c.p0[k], m), (m, c.p1[k])]
+            } else {
+                vec![(c.p0[k], c.p1[k])]
+            }
+        };
+        let mut out = Vec::with_capacity(4);
+        for (a0, a1) in cuts(0) {
+            for (b0, b1) in cuts(1) {
+                out.push(self.make_cell([a0, b0], [a1, b1]));
+            }
+        }
+        Split::Cells(out)
+    }
+
+    /// Local minima among the nodes of the cells that may still hold a point at or below
+    /// `upper`: for each such cell its lowest corner, kept when it is not above its neighbours at
+    /// the cell's own scale (ties broken by position). Lowest first.
+    pub fn candidates(&mut self, upper: f64) -> Vec<Candidate> {
+        let cells: Vec<Cell> = self
+            .done
+            .iter()
+            .chain(&self.fine)
+            .chain(self.unresolved.iter().map(|(c, _)| c))
+            .filter(|c| c.bound.lb <= upper && !c.failed)
+            .copied()
+            .collect();
+        let mut seen: HashSet<[u64; 2], BuildHasherDefault<Mix>> = HashSet::default();
+        let mut out = Vec::new();
+        for c in cells {
+            let corners = [c.p0, [c.p1[0], c.p0[1]], [c.p0[0], c.p1[1]], c.p1];
+            let mut low = (f64::INFINITY, c.p0);
+            for p in corners {
+                let (v, _) = self.node_at(p);
+                if v < low.0 {
+                    low = (v, p);
+                }
+            }
+            let (v, p) = low;
+            if !v.is_finite() || !seen.insert(p) {
+                continue;
+            }
+            let w = [c.p1[0] - c.p0[0], c.p1[1] - c.p0[1]];
+            let mut is_min = true;
+            'nb: for k in 0..2 {
+                if w[k] == 0 {
+                    continue;
+                }
+                for s in [-1i64, 1] {
+                    let q = p[k] as i64 + s * w[k] as i64;
+                    if q < 0 || q as u64 > self.axes[k].span() {
+                        continue;
+                    }
+                    let mut pq = p;
+                    pq[k] = q as u64;
+                    let (u, _) = self.node_at(pq);
+                    if u < v || (u == v && (pq[0], pq[1]) < (p[0], p[1])) {
+                        is_min = false;
+                        break 'nb;
+                    }
+                }
+            }
+            if is_min {
+                let (_, r) = self.node_at(p);
+                out.push(self.candidate(p, r, v, w, c.bound.lb));
+            }
+        }
+        out.sort_by(|a, b| a.chi2.total_cmp(&b.chi2));
+        out
+    }
+
+    /// The certificate for `upper` (see [`Certificate`]).
+    pub fn certificate(&self, upper: f64) -> Certificate {
+        let lowest = |it: &mut dyn Iterator<Item = &Cell>| {
+            it.map(|c| c.bound.lb).fold(f64::INFINITY, |a, b| if b < a { b } else { a })
+        };
+        let coarse = lowest(
+            &mut self
+                .done
+                .iter()
+                .chain(self.unresolved.iter().map(|(c, _)| c))
+                .chain(self.heap.iter().map(|b| &b.0)),
+        );
+        let mut reasons: Vec<String> = Vec::new();
+        for (c, w) in &self.unresolved {
+            if c.bound.lb < upper && !reasons.contains(w) {
+                reasons.push(w.clone());
+            }
+        }
+        Certificate {
+            lowest: coarse,
+            lowest_fine: lowest(&mut self.fine.iter()),
+            fine_cells: self.fine.len(),
+            reasons,
+        }
+    }
+}
+
+/// What a [`Bnb`] established.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Certificate {
+    /// No point outside the fine cells has chi2 below this.
+    pub lowest: f64,
+    /// The lowest bound of the fine cells (+inf without any).
+    pub lowest_fine: f64,
+    pub fine_cells: usize,
+    /// Why some cells with a bound below U were left unresolved (empty when none were).
+    pub reasons: Vec<String>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// f(x, y) = g(x) + (y - 0.3)^2 with g having minima at x = -1 (value 0.5) and x = 2
+    /// (value 0): both parts are monotone on each side of their minima, so the exact range of
+    /// f over a cell is known and the bound below is exact.
+    struct TwoWells {
+        x: Vec<f64>,
+        y: Vec<f64>,
+    }
+    fn g(x: f64) -> f64 {
+        ((x + 1.0).powi(2) + 0.5).min((x - 2.0).powi(2))
+    }
+    fn lowest(f: impl Fn(f64) -> f64, a: f64, b: f64, minima: &[f64]) -> f64 {
+        let mut v = f(a).min(f(b));
+        for &m in minima {
+            if a <= m && m <= b {
+                v = v.min(f(m));
+            }
+        }
+        v
+    }
+    impl Landscape for TwoWells {
+        fn add_row(&mut self, axis: usize, t: f64) -> Result<(), String> {
+            if axis == 0 { self.x.push(t) } else { self.y.push(t) }
+            Ok(())
+        }
+        fn node(&self, r: [usize; 2]) -> f64 {
+            g(self.x[r[0]]) + (self.y[r[1]] - 0.3).powi(2)
+        }
+        fn bound(&self, lo: [usize; 2], hi: [usize; 2], _target: f64) -> Bound {
+            // g's minima and the kink where its two branches meet (x = 1/6, where the lower
+            // envelope has a local maximum) are the only interior extremes.
+            let gx = lowest(g, self.x[lo[0]], self.x[hi[0]], &[-1.0, 2.0]);
+            let gy = lowest(|y| (y - 0.3f64).powi(2), self.y[lo[1]], self.y[hi[1]], &[0.3]);
+            Bound {
+                lb: gx + gy,
+                loose: [self.x[hi[0]] - self.x[lo[0]], self.y[hi[1]] - self.y[lo[1]]],
+            }
+        }
+    }
+
+    #[test]
+    fn certifies_two_wells_and_proposes_both() {
+        let land = TwoWells {
+            x: vec![],
+            y: vec![],
+        };
+        let limits = Limits {
+            max_cells: 100_000,
+            max_rows: 10_000,
+        };
+        let mut b = Bnb::new(land, [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], limits);
+        let tau = |_: f64| 1e-3;
+        let starts = b.initial_minima(f64::INFINITY, 1e-3);
+        // The starting grid (x step 1, y step 0.5) has its nodes at x = -1 and 2: both wells.
+        assert!(starts.iter().any(|c| c.t[0] == -1.0) && starts.iter().any(|c| c.t[0] == 2.0));
+        // With the true minimum 0 as U, everything is certified within tau.
+        b.refine(0.0, &tau);
+        let c = b.certificate(0.0);
+        assert!(
+            c.lowest >= -1e-3 && c.lowest <= 0.0 && c.reasons.is_empty() && c.fine_cells == 0,
+            "{c:?}"
+        );
+        // Candidates near the global minimum (2, 0.3) are proposed; the other well (0.5 above)
+        // is excluded by its bounds.
+        let c = b.candidates(0.0);
+        assert!(!c.is_empty());
+        for cand in &c {
+            assert!((cand.t[0] - 2.0).abs() < 0.1 && (cand.t[1] - 0.3).abs() < 0.1, "{cand:?}");
+        }
+        // A budget of one cell cannot certify: the cells are reported unresolved.
+        let land = TwoWells {
+            x: vec![],
+            y: vec![],
+        };
+        let tight = Limits {
+            max_cells: 1,
+            max_rows: 10_000,
+        };
+        let mut b = Bnb::new(land, [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], tight);
+        b.refine(0.0, &tau);
+        let c = b.certificate(0.0);
+        assert!(
+            c.lowest < -1e-3 && c.reasons.iter().any(|w| w.contains("budget")),
+            "{c:?}"
+        );
+    }
+}

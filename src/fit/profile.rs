@@ -1,0 +1,226 @@
+//! 95% profile-likelihood intervals.
+//!
+//! **Solves**, for each parameter j, the ends of {t : P_j(t) <= chi2_min + Delta}, where the
+//! profile P_j(t) is chi2 minimised over the other parameters with theta_j = t and
+//! Delta = 3.84 s (s the chi2 scale of [`super::objective`]; the same s scales `stderr`, so for a
+//! model linear in its parameters the interval is value +- 1.96 stderr). Reference: Venzon &
+//! Moolgavkar, Applied Statistics 37, 87 (1988); the PDG's "Statistics" review, section 40.3.2.
+//!
+//! **Method**: from the minimum, steps of about one standard error outwards, doubling, until the
+//! profile passes the threshold or the search box ends (an open side: the parameter is a bound);
+//! then the crossing by Brent's root finder ([`super::scalar::profile_crossing`]). The inner
+//! minimisation is Levenberg-Marquardt warm-started from the nearest profile point already
+//! computed, so a profile follows its valley. A profile point below the minimum reveals a lower
+//! minimum: the caller refits from it. Every failure is a value: a side whose crossing could
+//! not be found is [`Side::Lost`] with the reason, and inner minimisations that did not converge
+//! are counted (their profile values are upper bounds, so the interval could be too short).
+//!
+//! **Known answer** (test below): a straight line's slope, whose profile interval is exactly
+//! the least-squares value +- sqrt(3.84) standard errors.
+
+use super::lsq::{self, Covariance, LmOptions, Residuals};
+use super::objective::{CHI2_1DOF_95, Objective};
+use super::scalar::{Crossing, profile_crossing};
+use crate::error::Result;
+use std::cell::{Cell, RefCell};
+
+/// One end of an interval, in internal coordinates.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Side {
+    At(f64),
+    /// The profile stays below the threshold up to the edge of the search box.
+    Open,
+    /// Not found; the reason.
+    Lost(String),
+}
+
+/// The intervals of every parameter.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Profiles {
+    /// Per parameter, the lower and upper end.
+    pub sides: Vec<[Side; 2]>,
+    /// Per parameter, inner minimisations that did not converge.
+    pub unconverged: Vec<u32>,
+    pub delta: f64,
+}
+
+/// The intervals, or a point whose chi2 beats the minimum (the search missed it).
+#[derive(Debug, Clone, PartialEq)]
+pub enum ProfileOutcome {
+    Done(Profiles),
+    Lower(Vec<f64>),
+}
+
+/// The profile-likelihood intervals around the minimum `theta` (chi2 `chi2_min`).
+pub fn profile_intervals(
+    obj: &Objective,
+    theta: &[f64],
+    chi2_min: f64,
+    cov: &Covariance,
+) -> Result<ProfileOutcome> {
+    profile_intervals_of(obj, theta, chi2_min, cov, obj.scale(chi2_min))
+}
+
+/// As [`profile_intervals`] for any problem, with the chi2 scale given.
+pub fn profile_intervals_of(
+    obj: &impl Residuals,
+    theta: &[f64],
+    chi2_min: f64,
+    cov: &Covariance,
+    scale: f64,
+) -> Result<ProfileOutcome> {
+    let k = obj.n_params();
+    let delta = CHI2_1DOF_95 * scale;
+    let threshold = chi2_min + delta;
+    // A profile point this far below the minimum means a missed minimum, not rounding.
+    let beaten = chi2_min - 1e-7 * chi2_min.abs().max(1.0);
+    let mut sides = Vec::with_capacity(k);
+    let mut unconverged = Vec::with_capacity(k);
+    let lm = LmOptions::default();
+    let (lower, upper) = (obj.lower(), obj.upper());
+    for j in 0..k {
+        if cov.degenerate[j] {
+            // Only a combination with other parameters is determined; a profile would end only
+            // at the edges of the other parameters' search ranges.
+            sides.push([Side::Open, Side::Open]);
+            unconverged.push(0);
+            continue;
+        }
+        let span = upper[j] - lower[j];
+        let step = (delta * cov.matrix[(j, j)]).sqrt();
+        let step = if step.is_finite() && step > 0.0 {
+            step.min(0.25 * span)
+        } else {
+            0.01 * span
+        };
+        let failed_inner = Cell::new(0u32);
+        let mut pair = [Side::Open, Side::Open];
+        for (s, limit) in [lower[j], upper[j]].into_iter().enumerate() {
+            let warm = RefCell::new(vec![(theta[j], theta.to_vec())]);
+            let lower_found = RefCell::new(None::<Vec<f64>>);
+            let profile = |t: f64| -> Result<f64> {
+                let mut start = warm
+                    .borrow()
+                    .iter()
+                    .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
+                    .map(|(_, th)| th.clone())
+                    .unwrap_or_else(|| theta.to_vec());
+                start[j] = t;
+                let (c, th) = if k == 1 {
+                    (lsq::chi2(obj, &start)?, start)
+                } else {
+                    let mut free = vec![true; k];
+                    free[j] = false;
+                    let r = lsq::levenberg_marquardt(obj, &start, &free, &lm)?;
+                    if !r.converged {
+                        failed_inner.set(failed_inner.get() + 1);
+                    }
+                    (r.chi2, r.theta)
+                };
+                if c < beaten && lower_found.borrow().is_none() {
+                    *lower_found.borrow_mut() = Some(th.clone());
+                }
+                warm.borrow_mut().push((t, th));
+                Ok(c)
+            };
+            // Crossings to 1e-7 in the internal coordinate (log parameters: 1e-7 relative).
+            let c = profile_crossing(profile, theta[j], limit, step, threshold, 1e-7)?;
+            if let Some(t) = lower_found.into_inner() {
+                return Ok(ProfileOutcome::Lower(t));
+            }
+            pair[s] = match c {
+                Crossing::At(t) => Side::At(t),
+                Crossing::Open => Side::Open,
+                Crossing::Failed(why) => Side::Lost(why),
+            };
+        }
+        sides.push(pair);
+        unconverged.push(failed_inner.get());
+    }
+    Ok(ProfileOutcome::Done(Profiles {
+        sides,
+        unconverged,
+        delta,
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::Result;
+
+    /// y = c0 + c1 x, sigma = 1, on x = 0..9 with a fixed non-linear-in-appearance noise.
+    struct Line {
+        x: Vec<f64>,
+        y: Vec<f64>,
+        lo: Vec<f64>,
+        hi: Vec<f64>,
+    }
+    impl Residuals for Line {
+        fn n_params(&self) -> usize {
+            2
+        }
+        fn n_residuals(&self) -> usize {
+            self.x.len()
+        }
+        fn residuals(&self, t: &[f64], out: &mut [f64]) -> Result<()> {
+            for i in 0..self.x.len() {
+                out[i] = t[0] + t[1] * self.x[i] - self.y[i];
+            }
+            Ok(())
+        }
+        fn lower(&self) -> &[f64] {
+            &self.lo
+        }
+        fn upper(&self) -> &[f64] {
+            &self.hi
+        }
+        fn fd_step(&self) -> f64 {
+            1e-5
+        }
+    }
+
+    #[test]
+    fn a_lines_profile_interval_is_its_closed_form() {
+        let x: Vec<f64> = (0..10).map(|i| i as f64).collect();
+        let y: Vec<f64> = x
+            .iter()
+            .enumerate()
+            .map(|(i, &x)| 1.0 + 0.5 * x + [0.3, -0.2, 0.1, -0.4, 0.2][i % 5])
+            .collect();
+        // Closed-form least squares: slope = Sxy/Sxx, var(slope) = 1/Sxx (sigma = 1).
+        let n = x.len() as f64;
+        let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+        let sxx: f64 = x.iter().map(|x| (x - mx).powi(2)).sum();
+        let sxy: f64 = x.iter().zip(&y).map(|(x, y)| (x - mx) * (y - my)).sum();
+        let slope = sxy / sxx;
+        let c0 = my - slope * mx;
+        let p = Line {
+            x,
+            y,
+            lo: vec![-100.0, -100.0],
+            hi: vec![100.0, 100.0],
+        };
+        let chi2 = lsq::chi2(&p, &[c0, slope]).unwrap();
+        let mut f0 = vec![0.0; 10];
+        p.residuals(&[c0, slope], &mut f0).unwrap();
+        let cov = lsq::covariance(&lsq::jacobian(&p, &[c0, slope], &[true, true], &f0).unwrap());
+        let out = profile_intervals_of(&p, &[c0, slope], chi2, &cov, 1.0).unwrap();
+        let ProfileOutcome::Done(pr) = out else {
+            panic!("{out:?}")
+        };
+        let half = (CHI2_1DOF_95 / sxx).sqrt();
+        // Crossings are found to 1e-7 in t; the inner LM stops at 1e-10: 1e-6 covers both.
+        match &pr.sides[1] {
+            [Side::At(a), Side::At(b)] => {
+                assert!((a - (slope - half)).abs() < 1e-6, "{a}");
+                assert!((b - (slope + half)).abs() < 1e-6, "{b}");
+            }
+            other => panic!("{other:?}"),
+        }
+        assert_eq!(pr.unconverged, vec![0, 0]);
+        // Started from a point that is not the minimum, a profile finds a lower one.
+        let off = profile_intervals_of(&p, &[c0 + 0.5, slope], chi2 + 2.5, &cov, 1.0).unwrap();
+        assert!(matches!(off, ProfileOutcome::Lower(_)), "{off:?}");
+    }
+}

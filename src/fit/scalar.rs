@@ -1,0 +1,336 @@
+//! One-dimensional methods of the fit: a minimum inside a bracket, and where a profile crosses a
+//! threshold.
+//!
+//! - [`brent_minimize`]: **solves** min f(x) on [a, b] by Brent's method (golden sections and
+//!   parabolic steps; Brent, "Algorithms for Minimization without Derivatives", 1973, ch. 5;
+//!   argmin's `BrentOpt`). **Needs** a bracket holding the minimum wanted (it finds a local one).
+//! - [`profile_crossing`]: **solves** profile(t) = threshold between a minimum t_hat and a search
+//!   limit: steps out from t_hat, doubling, until the profile reaches the threshold, then Brent's
+//!   root finder (Brent 1973, ch. 4; argmin's `BrentRoot`) inside the bracket, with bisection as
+//!   the fallback when a re-minimised profile does not reproduce the sign change at the ends.
+//!
+//! Every loop is capped; a NaN value, an exhausted cap or a solver that stopped for any reason
+//! other than convergence is reported in the result (`converged: false`, [`Crossing::Failed`]),
+//! never passed on as a number. An `Err` raised by the function itself is returned as it is.
+//!
+//! **Known answers** (tests below): a parabola's minimum and its crossings at 2 +- sqrt(3.84).
+
+use crate::error::{Error, Result};
+use argmin::core::{CostFunction, Executor, State, TerminationReason};
+use argmin::solver::brent::{BrentOpt, BrentRoot};
+use std::cell::RefCell;
+
+/// Iteration cap of Brent's minimisation (it converges linearly at worst, by golden sections:
+/// 0.618^200 of any bracket is below the resolution of a double).
+const BRENT_MIN_ITERS: u64 = 200;
+/// Iteration cap of Brent's root finder (same argument, with bisection steps).
+const BRENT_ROOT_ITERS: u64 = 200;
+/// Doublings of the outward step of [`profile_crossing`]: 2^80 steps of at least `tol` reach any
+/// finite limit.
+const MAX_DOUBLINGS: usize = 80;
+/// Bisections of the fallback: 200 halvings reach the resolution of a double from any interval.
+const MAX_BISECTIONS: usize = 200;
+
+/// A scalar function for argmin's Brent solvers; the function's own errors and NaN values are
+/// kept aside (argmin's error type would lose them) and reported by the caller.
+struct Scalar<'a, F: FnMut(f64) -> Result<f64>> {
+    f: RefCell<F>,
+    failure: &'a RefCell<Option<Failure>>,
+    offset: f64,
+}
+
+enum Failure {
+    Model(Error),
+    NotANumber(f64),
+}
+
+impl<F: FnMut(f64) -> Result<f64>> CostFunction for Scalar<'_, F> {
+    type Param = f64;
+    type Output = f64;
+    fn cost(&self, x: &f64) -> std::result::Result<f64, argmin::core::Error> {
+        match (self.f.borrow_mut())(*x) {
+            Ok(v) if v.is_nan() => {
+                *self.failure.borrow_mut() = Some(Failure::NotANumber(*x));
+                Err(argmin::core::Error::msg("NaN"))
+            }
+            Ok(v) => Ok(v - self.offset),
+            Err(e) => {
+                *self.failure.borrow_mut() = Some(Failure::Model(e.clone()));
+                Err(e.into())
+            }
+        }
+    }
+}
+
+/// A one-dimensional minimum.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Minimum1d {
+    pub x: f64,
+    pub fx: f64,
+    pub converged: bool,
+    /// Why it stopped.
+    pub reason: String,
+}
+
+/// Minimum of f on [a, b] by Brent's method, to |x| 1.5e-8 + `abs_tol` (the relative part is
+/// sqrt(machine epsilon), the best a minimiser from function values can do). The bracket ends
+/// themselves are never evaluated.
+pub fn brent_minimize(
+    f: impl FnMut(f64) -> Result<f64>,
+    a: f64,
+    b: f64,
+    abs_tol: f64,
+) -> Result<Minimum1d> {
+    if !(a.is_finite() && b.is_finite() && a < b) {
+        return Err(Error::InvalidParameter {
+            name: "Brent bracket",
+            value: b - a,
+            expected: "finite ends a < b",
+        });
+    }
+    let failure = RefCell::new(None);
+    let problem = Scalar {
+        f: RefCell::new(f),
+        failure: &failure,
+        offset: 0.0,
+    };
+    let solver = BrentOpt::new(a, b).set_tolerance(f64::EPSILON.sqrt(), abs_tol);
+    let res = Executor::new(problem, solver)
+        .configure(|s| s.max_iters(BRENT_MIN_ITERS))
+        .run();
+    match res {
+        Ok(r) => {
+            let st = r.state();
+            let x = st.get_best_param().copied().unwrap_or(f64::NAN);
+            let fx = st.get_best_cost();
+            let reason = st.get_termination_reason();
+            let converged = matches!(reason, Some(TerminationReason::SolverConverged));
+            if !(x.is_finite() && !fx.is_nan()) {
+                return Ok(Minimum1d {
+                    x: 0.5 * (a + b),
+                    fx: f64::NAN,
+                    converged: false,
+                    reason: "Brent returned no point".into(),
+                });
+            }
+            Ok(Minimum1d {
+                x,
+                fx,
+                converged,
+                reason: match reason {
+                    Some(r) => r.text().to_string(),
+                    None => "not terminated".into(),
+                },
+            })
+        }
+        Err(e) => match failure.take() {
+            Some(Failure::Model(err)) => Err(err),
+            Some(Failure::NotANumber(x)) => Ok(Minimum1d {
+                x,
+                fx: f64::NAN,
+                converged: false,
+                reason: format!("the function is NaN at {x}"),
+            }),
+            None => Ok(Minimum1d {
+                x: 0.5 * (a + b),
+                fx: f64::NAN,
+                converged: false,
+                reason: format!("Brent failed: {e}"),
+            }),
+        },
+    }
+}
+
+/// Where a profile reaches its threshold, seen from the minimum.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Crossing {
+    /// It crosses here (to the tolerance asked).
+    At(f64),
+    /// It stays below the threshold up to the search limit: the interval is open on this side.
+    Open,
+    /// The crossing could not be found; the reason says why.
+    Failed(String),
+}
+
+/// The point between `t_hat` and `limit` where `profile(t)` first reaches `threshold` (see the
+/// module doc). `profile(t_hat)` must be below `threshold`; trial points go out from `t_hat` by
+/// `step`, doubling.
+pub fn profile_crossing(
+    mut profile: impl FnMut(f64) -> Result<f64>,
+    t_hat: f64,
+    limit: f64,
+    step: f64,
+    threshold: f64,
+    tol: f64,
+) -> Result<Crossing> {
+    if ![t_hat, limit, step, threshold, tol].iter().all(|x| x.is_finite()) || !(tol > 0.0) {
+        return Ok(Crossing::Failed(format!(
+            "non-finite search settings (t = {t_hat}, limit = {limit}, step = {step}, \
+             threshold = {threshold})"
+        )));
+    }
+    if limit == t_hat {
+        return Ok(Crossing::Open);
+    }
+    let dir = (limit - t_hat).signum();
+    let mut inner = t_hat;
+    let mut dist = step.abs().max(tol);
+    let mut outer = None;
+    for _ in 0..MAX_DOUBLINGS {
+        let t = if (t_hat + dir * dist - limit) * dir >= 0.0 {
+            limit
+        } else {
+            t_hat + dir * dist
+        };
+        let v = profile(t)?;
+        if v.is_nan() {
+            return Ok(Crossing::Failed(format!("the profile is NaN at {t}")));
+        }
+        if v >= threshold {
+            outer = Some(t);
+            break;
+        }
+        if t == limit {
+            return Ok(Crossing::Open);
+        }
+        inner = t;
+        dist *= 2.0;
+    }
+    let Some(outer) = outer else {
+        return Ok(Crossing::Failed(format!(
+            "no crossing within {MAX_DOUBLINGS} doublings of the step"
+        )));
+    };
+    let failure = RefCell::new(None);
+    let shared = RefCell::new(&mut profile);
+    let problem = Scalar {
+        f: RefCell::new(|t: f64| (shared.borrow_mut())(t)),
+        failure: &failure,
+        offset: threshold,
+    };
+    let (a, b) = if inner < outer {
+        (inner, outer)
+    } else {
+        (outer, inner)
+    };
+    let res = Executor::new(problem, BrentRoot::new(a, b, tol))
+        .configure(|s| s.max_iters(BRENT_ROOT_ITERS))
+        .run();
+    match (res, failure.take()) {
+        (_, Some(Failure::Model(e))) => return Err(e),
+        (_, Some(Failure::NotANumber(t))) => {
+            return Ok(Crossing::Failed(format!("the profile is NaN at {t}")));
+        }
+        (Ok(r), None) => {
+            let st = r.state();
+            let converged = matches!(
+                st.get_termination_reason(),
+                Some(TerminationReason::SolverConverged)
+            );
+            if let (true, Some(&x)) = (converged, st.get_best_param())
+                && x.is_finite()
+            {
+                return Ok(Crossing::At(x));
+            }
+            // Any other stop (the iteration cap): fall through to bisection.
+        }
+        (Err(_), None) => {
+            // No sign change at the ends on re-evaluation: a profile that re-minimises the other
+            // parameters need not return the same value twice (its inner minimisation may
+            // settle elsewhere). Bisection below trusts the classification of each new point.
+        }
+    }
+    let (mut below, mut above) = (inner, outer);
+    for _ in 0..MAX_BISECTIONS {
+        if (above - below).abs() <= tol {
+            return Ok(Crossing::At(0.5 * (below + above)));
+        }
+        let mid = 0.5 * (below + above);
+        if mid == below || mid == above {
+            // The resolution of a double: as close as the crossing can be located.
+            return Ok(Crossing::At(mid));
+        }
+        let v = (shared.borrow_mut())(mid)?;
+        if v.is_nan() {
+            return Ok(Crossing::Failed(format!("the profile is NaN at {mid}")));
+        }
+        if v >= threshold {
+            above = mid;
+        } else {
+            below = mid;
+        }
+    }
+    Ok(Crossing::Failed(format!(
+        "bisection did not reach the tolerance in {MAX_BISECTIONS} steps"
+    )))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn brent_minimum_and_profile_crossing() {
+        // (x - 2)^2 + 1: minimum 1 at 2; crossing of 1 + 3.84 at 2 +- sqrt(3.84). Tolerances:
+        // Brent's x to sqrt(eps) relative (1e-7 allows it), f(x) then to (1e-7)^2; the
+        // crossings to the 1e-10 asked (1e-9 allows the last step).
+        let m = brent_minimize(|x| Ok((x - 2.0).powi(2) + 1.0), -5.0, 10.0, 1e-12).unwrap();
+        assert!(
+            m.converged && (m.x - 2.0).abs() < 1e-7 && (m.fx - 1.0).abs() < 1e-13,
+            "{m:?}"
+        );
+        let f = |x: f64| Ok((x - 2.0f64).powi(2) + 1.0);
+        let at = |c: Crossing| match c {
+            Crossing::At(x) => x,
+            other => panic!("{other:?}"),
+        };
+        let up = at(profile_crossing(f, 2.0, 100.0, 0.5, 4.84, 1e-10).unwrap());
+        assert!((up - (2.0 + 3.84f64.sqrt())).abs() < 1e-9, "{up}");
+        let down = at(profile_crossing(f, 2.0, -100.0, 0.5, 4.84, 1e-10).unwrap());
+        assert!((down - (2.0 - 3.84f64.sqrt())).abs() < 1e-9, "{down}");
+        // A plateau: never reaches the threshold before the limit.
+        let flat = |x: f64| Ok(if x < 2.0 { (x - 2.0f64).powi(2) } else { 0.0 });
+        assert_eq!(
+            profile_crossing(flat, 2.0, 50.0, 0.5, 3.84, 1e-10).unwrap(),
+            Crossing::Open
+        );
+        let down = at(profile_crossing(flat, 2.0, -50.0, 0.5, 3.84, 1e-10).unwrap());
+        assert!((down - (2.0 - 3.84f64.sqrt())).abs() < 1e-9, "{down}");
+    }
+
+    #[test]
+    fn failures_are_reported_not_hidden() {
+        // NaN inputs or values: a failure with the reason, no hang (the old code looped forever
+        // on a NaN start).
+        let f = |x: f64| Ok((x - 2.0f64).powi(2));
+        assert!(matches!(
+            profile_crossing(f, f64::NAN, 10.0, 0.5, 3.84, 1e-10).unwrap(),
+            Crossing::Failed(_)
+        ));
+        let nan_beyond = |x: f64| Ok(if x > 3.0 { f64::NAN } else { 0.0 });
+        assert!(matches!(
+            profile_crossing(nan_beyond, 2.0, 10.0, 0.5, 3.84, 1e-10).unwrap(),
+            Crossing::Failed(_)
+        ));
+        let m = brent_minimize(|x| Ok(if x > 1.0 { f64::NAN } else { x }), 0.0, 3.0, 1e-9).unwrap();
+        assert!(!m.converged, "{m:?}");
+        // A model error is passed on as it is.
+        let err = |_: f64| -> Result<f64> {
+            Err(Error::InvalidParameter {
+                name: "x",
+                value: 1.0,
+                expected: "y",
+            })
+        };
+        assert!(profile_crossing(err, 2.0, 10.0, 0.5, 3.84, 1e-10).is_err());
+        // A profile that gives different values at the same point (re-minimisation settling
+        // elsewhere) still ends, by bisection: a step function with a threshold at 3.
+        let mut calls = 0;
+        let flaky = |x: f64| {
+            calls += 1;
+            Ok(if x >= 3.0 { 10.0 } else { (calls % 2) as f64 })
+        };
+        let c = profile_crossing(flaky, 2.0, 10.0, 0.5, 5.0, 1e-10).unwrap();
+        assert!(matches!(c, Crossing::At(x) if (x - 3.0).abs() < 1e-9), "{c:?}");
+    }
+}
