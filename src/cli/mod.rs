@@ -4,6 +4,7 @@
 use restitution::contact::{Material, PRESETS};
 
 pub mod bench;
+pub mod export;
 pub mod fit;
 pub mod kinematics;
 pub mod predict;

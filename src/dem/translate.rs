@@ -191,3 +191,61 @@ impl Translation {
         self.request.curve.e(&self.pairs[p].contact, v_m_s)
     }
 }
+
+/// The law an engine file carries, with what it needs to predict the engine's e.
+#[derive(Debug, Clone, PartialEq)]
+pub enum EngineLaw {
+    /// Hertz with viscoelastic damping eta (LAMMPS `damping viscoelastic`).
+    Viscoelastic { eta: f64 },
+    /// Hertz with Tsuji's dashpot, one alpha per pair (LAMMPS `damping tsuji`).
+    Tsuji { alpha: Vec<f64> },
+}
+
+/// One head-on collision of a verification run: what the law predicts for it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Collision {
+    pub pair: usize,
+    pub v_m_s: f64,
+    /// e of the law (what the engine must reproduce).
+    pub e: f64,
+    /// How long the contact lasts, s.
+    pub contact_time_s: f64,
+}
+
+impl Translation {
+    /// e and contact duration of the exported law for every pair at every speed (ODE for the
+    /// viscoelastic law, [`damped::rebound`] for Tsuji's).
+    pub fn collisions(&self, law: &EngineLaw, speeds: &[f64]) -> Result<Vec<Collision>> {
+        let rule = self.request.curve.rule;
+        let mut out = Vec::new();
+        for (p, pair) in self.pairs.iter().enumerate() {
+            for &v in speeds {
+                crate::error::positive("collision speed (m/s)", v)?;
+                let (e, contact_time_s) = match law {
+                    EngineLaw::Viscoelastic { eta } => {
+                        let im =
+                            crate::models::viscoelastic::Viscoelastic::new(pair.contact, *eta)?
+                                .impact(
+                                    v,
+                                    rule,
+                                    &crate::models::viscoelastic::OdeSettings::DEFAULT,
+                                )?;
+                        (im.e, im.contact_time_s)
+                    }
+                    EngineLaw::Tsuji { alpha } => {
+                        let r =
+                            damped::rebound(alpha[p], Dashpot::Tsuji, rule, damped::DEFAULT_STEPS)?;
+                        (r.e, r.tau_contact * pair.contact.time_scale_s(v))
+                    }
+                };
+                out.push(Collision {
+                    pair: p,
+                    v_m_s: v,
+                    e,
+                    contact_time_s,
+                });
+            }
+        }
+        Ok(out)
+    }
+}
