@@ -17,6 +17,17 @@ struct Curve {
     constant: Option<f64>,
 }
 
+/// Log-axis tick labels at 1, 2 and 5 times a power of ten only (plotters offers every
+/// integer multiple, whose labels collide near the top of each decade).
+fn tick(v: &f64) -> String {
+    let lead = *v / 10f64.powf(v.log10().floor());
+    if [1.0, 2.0, 5.0].iter().any(|l| (lead - l).abs() < 1e-6) {
+        crate::data::fmt_num(*v)
+    } else {
+        String::new()
+    }
+}
+
 fn err<E: std::fmt::Display>(e: E) -> String {
     format!("drawing laws.svg: {e}")
 }
@@ -70,9 +81,9 @@ pub fn laws_svg(tr: &Translation, title: &str) -> Result<String, String> {
 
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (1300, 640)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, (1300, 680)).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
-        let (top, bottom) = root.split_vertically(600);
+        let (top, bottom) = root.split_vertically(610);
         let top = top.titled(title, ("sans-serif", 26)).map_err(err)?;
         let (left, right) = top.split_horizontally(650);
         let xr = (range.lo_m_s..range.hi_m_s).log_scale();
@@ -84,6 +95,8 @@ pub fn laws_svg(tr: &Translation, title: &str) -> Result<String, String> {
             .build_cartesian_2d(xr.clone(), y0..y1)
             .map_err(err)?;
         a.configure_mesh()
+            .x_labels(12)
+            .x_label_formatter(&tick)
             .x_desc("normal impact speed v (m/s)")
             .y_desc("e")
             .axis_desc_style(("sans-serif", 20))
@@ -119,9 +132,19 @@ pub fn laws_svg(tr: &Translation, title: &str) -> Result<String, String> {
             .build_cartesian_2d(xr, -dmax..dmax)
             .map_err(err)?;
         b.configure_mesh()
+            .x_labels(12)
+            .x_label_formatter(&tick)
             .x_desc("normal impact speed v (m/s)")
             .y_desc("e_law − e_fitted")
-            .y_label_formatter(&|v| format!("{v:.1e}"))
+            // Ticks land a rounding away from 0 (printed 1.7e-18): snap them.
+            .y_label_formatter(&|v| {
+                let v = if v.abs() < 1e-9 * dmax { 0.0 } else { *v };
+                if dmax >= 1e-3 {
+                    format!("{v:.3}")
+                } else {
+                    format!("{v:.1e}")
+                }
+            })
             .axis_desc_style(("sans-serif", 20))
             .label_style(("sans-serif", 17))
             .light_line_style(WHITE.mix(0.0))
@@ -200,7 +223,7 @@ fn legend_row(
         }
         area.draw(&Text::new(label.clone(), (x + 44, y - 9), font.clone()))
             .map_err(err)?;
-        x += 60 + 9 * label.chars().count() as i32;
+        x += 60 + 8 * label.chars().count() as i32;
     }
     if let Some(t) = tol {
         area.draw(&Rectangle::new(
@@ -209,11 +232,12 @@ fn legend_row(
         ))
         .map_err(err)?;
         let label = format!("tolerance ±{t}");
-        area.draw(&Text::new(label.clone(), (x + 38, y - 9), font.clone()))
+        area.draw(&Text::new(label, (x + 38, y - 9), font.clone()))
             .map_err(err)?;
-        x += 50 + 9 * label.chars().count() as i32;
     }
-    x += 20;
+    // Pairs on a second row (with many sizes they would run off a single one).
+    let y = 48;
+    let mut x = 20;
     area.draw(&Text::new("pairs:", (x, y - 9), font.clone()))
         .map_err(err)?;
     x += 60;
@@ -225,7 +249,7 @@ fn legend_row(
         .map_err(err)?;
         area.draw(&Text::new(c.label.clone(), (x + 30, y - 9), font.clone()))
             .map_err(err)?;
-        x += 40 + 10 * c.label.chars().count() as i32;
+        x += 40 + 9 * c.label.chars().count() as i32;
     }
     Ok(())
 }
