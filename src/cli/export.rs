@@ -28,14 +28,14 @@
 
 use super::{CliResult, MaterialArgs};
 use restitution::contact::Material;
-use restitution::data::export::files::{self, Summary};
-use restitution::data::export::lammps::{self, Friction, LammpsLaw};
-use restitution::data::export::{read_params_json, read_walton_json};
+use restitution::data::export::lammps::Friction;
+use restitution::data::export::plan::{self, EngineKind, LawChoice};
+use restitution::data::export::{files, read_params_json, read_walton_json, report, run};
 use restitution::data::write_all_atomic;
 use restitution::dem::law::FittedCurve;
 use restitution::dem::range::{SpeedRange, Weight};
 use restitution::dem::scene::Scene;
-use restitution::dem::translate::{Request, Translation, constant_e_inputs};
+use restitution::dem::translate::{Request, Translation};
 use restitution::fit::models::ModelKind;
 use restitution::models::viscoelastic::ContactEnd;
 use restitution::plot::export::laws_svg;
@@ -311,171 +311,59 @@ pub fn run(a: Args) -> CliResult {
     })
     .map_err(|e| format!("{source}: {e}"))?;
 
-    let speeds: Vec<f64> = if !a.speeds.is_empty() {
+    let speeds: Vec<f64> = if a.speeds.is_empty() {
+        plan::default_speeds(a.v_range)
+    } else {
         for &v in &a.speeds {
             check_positive("--speeds", v)?;
         }
         a.speeds.clone()
-    } else if let Some(r) = a.v_range {
-        vec![r.lo_m_s, (r.lo_m_s * r.hi_m_s).sqrt(), r.hi_m_s]
-    } else {
-        vec![0.5, 2.0, 10.0]
     };
-    let rule = tr.request.curve.rule;
-    let const_inputs = match &tr.constant {
-        Some(c) if a.engine == Engine::ConstantE || a.engine == Engine::Lammps => Some(
-            c.iter()
-                .map(|x| constant_e_inputs(x.e_mean, rule))
-                .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| format!("constant e: {e}"))?,
-        ),
-        _ => None,
+    let engine = match a.engine {
+        Engine::Lammps => EngineKind::Lammps,
+        Engine::ConstantE => EngineKind::ConstantE,
+        Engine::Table => EngineKind::Table,
     };
-    let tsuji_law = |note: String| -> Result<LammpsLaw, String> {
-        let inputs = const_inputs.as_ref().ok_or("constant e needs --v-range")?;
-        Ok(LammpsLaw::Tsuji {
-            // The polynomial cannot ask for less damping than at cor = 1 (e above 0.99958):
-            // then cor = 1, and collide.in's expected e says what LAMMPS gives instead.
-            cor: inputs.iter().map(|i| i.lammps_cor.unwrap_or(1.0)).collect(),
-            note,
-        })
+    let law = match a.law {
+        LawArg::Auto => LawChoice::Auto,
+        LawArg::Viscoelastic => LawChoice::Viscoelastic,
+        LawArg::ConstantE => LawChoice::ConstantE,
     };
-    let vm = &tr.viscoelastic;
-    let lammps_law = match a.engine {
-        Engine::Table => None,
-        Engine::ConstantE => Some(tsuji_law(
-            "Hertz with Tsuji's damping, a constant e per pair (the weighted mean of the fitted e(v) \
-             over the speed range; constant_e.csv)"
-                .into(),
-        )?),
-        Engine::Lammps => {
-            let const_dev = tr
-                .constant
-                .as_ref()
-                .map(|c| c.iter().map(|x| x.dev_mean).fold(0.0, f64::max));
-            let use_const = match a.law {
-                LawArg::Viscoelastic => false,
-                LawArg::ConstantE => true,
-                LawArg::Auto => !vm.exact && const_dev.is_some_and(|d| d < vm.dev_mean),
-            };
-            if use_const {
-                Some(tsuji_law(format!(
-                    "constant e per pair (largest deviation from the fitted {} curve {:.3e}; the \
-                     closest viscoelastic law would deviate by {:.3e})",
-                    tr.request.curve.kind,
-                    const_dev.unwrap_or(f64::NAN),
-                    vm.dev_mean
-                ))?)
-            } else if vm.exact {
-                Some(LammpsLaw::Viscoelastic {
-                    eta: vm.eta_mean,
-                    note: format!(
-                        "Hertz + viscoelastic damping (Eqs. 9-10) with the fitted eta = {} kg/(s m): exact",
-                        restitution::data::fmt_num(vm.eta_mean)
-                    ),
-                })
-            } else {
-                Some(LammpsLaw::Viscoelastic {
-                    eta: vm.eta_mean,
-                    note: format!(
-                        "the viscoelastic law closest to the fitted {} curve (eta = {} kg/(s m), \
-                         least squares over the speed range): largest deviation {:.3e}{}",
-                        tr.request.curve.kind,
-                        restitution::data::fmt_num(vm.eta_mean),
-                        vm.dev_mean,
-                        const_dev
-                            .map(|d| format!("; a constant e would deviate by {d:.3e}"))
-                            .unwrap_or_default()
-                    ),
-                })
-            }
-        }
-    };
-
-    let mut outputs: Vec<(String, Vec<u8>)> = Vec::new();
-    let mut lammps_files = None;
-    if let Some(law) = &lammps_law {
-        let lf = lammps::lammps_files(&tr, law, friction.as_ref(), &speeds, &source)?;
-        outputs.push((
-            "in.restitution".into(),
-            lf.in_restitution.clone().into_bytes(),
-        ));
-        outputs.push(("collide.in".into(), lf.collide_in.clone().into_bytes()));
-        lammps_files = Some(lf);
-    }
-    let shown_inputs = if a.engine == Engine::ConstantE {
-        const_inputs.as_deref()
-    } else {
-        None
-    };
-    if let Some(inputs) = shown_inputs {
-        outputs.push((
-            "constant_e.csv".into(),
-            files::constant_e_csv(&tr, inputs)?.into_bytes(),
-        ));
-        outputs.push((
-            "liggghts.in".into(),
-            files::liggghts_input(&tr, inputs, friction.as_ref()).into_bytes(),
-        ));
-    }
-    if a.engine == Engine::Table {
-        outputs.push(("table.csv".into(), files::table_csv(&tr)?.into_bytes()));
-    }
+    let plan = plan::plan(&tr, engine, law, friction.as_ref(), &speeds, &source)?;
+    let mut outputs = plan.outputs.clone();
     if tr.request.range.is_some() {
-        let title = format!(
-            "Exported laws for model {} ({})",
-            tr.request.curve.kind, source
-        );
+        let title = format!("Exported laws for {source}");
         outputs.push(("laws.svg".into(), laws_svg(&tr, &title)?.into_bytes()));
     }
-
-    // --verify needs the LAMMPS files on disk: DIR, or a private temporary directory.
-    let verify_rows = if a.verify {
-        let lf = lammps_files
-            .as_ref()
-            .expect("verify is refused for the table engine");
-        let dir = match &a.out {
-            Some(d) => d.clone(),
-            None => std::env::temp_dir().join(format!("restitution-verify-{}", std::process::id())),
-        };
-        std::fs::create_dir_all(&dir)
-            .map_err(|e| format!("{}: cannot create the directory: {e}", dir.display()))?;
-        let scratch = [
-            (
-                dir.join("in.restitution"),
-                lf.in_restitution.clone().into_bytes(),
-            ),
-            (dir.join("collide.in"), lf.collide_in.clone().into_bytes()),
-        ];
-        let result = write_all_atomic(&scratch)
-            .map_err(|e| format!("{}: cannot write: {e}", dir.display()))
-            .and_then(|_| lammps::verify(&dir, &tr, &lf.collisions, &LADDER));
-        if a.out.is_none() {
-            let _ = std::fs::remove_dir_all(&dir);
+    // A failed verification writes nothing (it runs in a private temporary directory).
+    let verify_rows = match (&plan.lammps_files, a.verify) {
+        (Some(lf), true) => {
+            let rows = run::verify_files(&tr, lf, &LADDER)?;
+            let worst = rows
+                .iter()
+                .map(|r| r.difference().abs())
+                .fold(0.0, f64::max);
+            if worst.is_nan() || worst > VERIFY_TOLERANCE {
+                eprint!("{}", files::verify_table(&rows, VERIFY_TOLERANCE));
+                return Err(format!(
+                    "LAMMPS's e differs from the toolkit's by {worst:.3e} > {VERIFY_TOLERANCE:e}; nothing written"
+                ));
+            }
+            Some(rows)
         }
-        Some(result?)
-    } else {
-        None
+        _ => None,
     };
-
     let mut names: Vec<String> = outputs.iter().map(|(n, _)| n.clone()).collect();
     if a.out.is_some() {
         names.push("export.json".into());
     }
-    let summary = Summary {
-        source: &source,
-        engine: match a.engine {
-            Engine::Lammps => "lammps",
-            Engine::ConstantE => "constant-e",
-            Engine::Table => "table",
-        },
-        tr: &tr,
-        lammps_law: lammps_law.as_ref(),
-        constant_inputs: shown_inputs,
-        friction: friction.as_ref(),
-        files: names,
-        verify: verify_rows.as_deref(),
-    };
+    let summary = plan.summary(
+        &tr,
+        &source,
+        friction.as_ref(),
+        names,
+        verify_rows.as_deref(),
+    );
     if let Some(dir) = &a.out {
         outputs.push((
             "export.json".into(),
@@ -483,24 +371,15 @@ pub fn run(a: Args) -> CliResult {
         ));
         write_outputs(dir, &outputs)?;
     }
-    print!("{}", files::report(&summary));
+    print!("{}", report::report(&summary));
     if a.out.is_none()
-        && let Some(lf) = &lammps_files
+        && let Some(lf) = &plan.lammps_files
     {
         print!("\n--- in.restitution ---\n{}", lf.in_restitution);
     }
     if let Some(rows) = &verify_rows {
-        println!("\nLAMMPS round trip (lmp on collide.in, steps per shortest contact as shown):");
+        println!("\nLAMMPS round trip (lmp on collide.in, N steps per shortest contact):");
         print!("{}", files::verify_table(rows, VERIFY_TOLERANCE));
-        let worst = rows
-            .iter()
-            .map(|r| r.difference().abs())
-            .fold(0.0, f64::max);
-        if !(worst <= VERIFY_TOLERANCE) {
-            return Err(format!(
-                "LAMMPS's e differs from the toolkit's by {worst:.3e} > {VERIFY_TOLERANCE:e}"
-            ));
-        }
     }
     Ok(())
 }

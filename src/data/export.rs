@@ -2,11 +2,15 @@
 //! and writing engine inputs, tables and the export summary (docs/physics.md §9). The numbers
 //! come from [`crate::dem`]; this module only formats and parses.
 //!
-//! Submodules: [`lammps`] (in.restitution, collide.in, running `lmp` and reading its e),
-//! [`files`] (constant_e.csv, table.csv, liggghts.in, export.json, the printed summary).
+//! Submodules: [`plan`] (which law and files an export gives), [`lammps`] (in.restitution,
+//! collide.in), [`run`] (running `lmp` on them and comparing e), [`files`] (constant_e.csv,
+//! table.csv, liggghts.in, export.json), [`report`] (the printed summary).
 
 pub mod files;
 pub mod lammps;
+pub mod plan;
+pub mod report;
+pub mod run;
 
 use super::DataError;
 use crate::contact::Material;

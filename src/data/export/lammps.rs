@@ -4,12 +4,9 @@
 
 use crate::data::fmt_num;
 use crate::dem::engines::lammps_tsuji_alpha;
-use crate::dem::richardson_first_order;
 use crate::dem::translate::{Collision, EngineLaw, LammpsViscoelastic, Translation};
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::path::Path;
-use std::process::Command;
 
 /// The law written into in.restitution.
 #[derive(Debug, Clone, PartialEq)]
@@ -60,30 +57,41 @@ pub struct LammpsFiles {
     pub collisions: Vec<Collision>,
 }
 
-fn coeff_line(
-    out: &mut String,
-    head: &str,
+/// One `hertz/material` coefficient set: the numbers of a pair_coeff line (or wall fix).
+struct Coeff<'a> {
     youngs: f64,
     damp: f64,
     nu: f64,
-    damping: &str,
+    damping: &'a str,
     kt: f64,
-    friction: Option<&Friction>,
+    friction: Option<&'a Friction>,
     force_rule: bool,
-    tail: &str,
-) {
-    let tangential = match friction {
-        Some(f) => format!("tangential mindlin {} 0 {}", fmt_num(kt), fmt_num(f.mu0)),
-        None => "tangential linear_nohistory 0 0".to_string(),
-    };
-    let _ = writeln!(
-        out,
-        "{head} hertz/material {} {} {} damping {damping} {tangential}{}{tail}",
-        fmt_num(youngs),
-        fmt_num(damp),
-        fmt_num(nu),
-        if force_rule { " limit_damping" } else { "" },
-    );
+}
+
+impl Coeff<'_> {
+    fn write(&self, out: &mut String, head: &str, tail: &str) {
+        let tangential = match self.friction {
+            Some(f) => format!(
+                "tangential mindlin {} 0 {}",
+                fmt_num(self.kt),
+                fmt_num(f.mu0)
+            ),
+            None => "tangential linear_nohistory 0 0".to_string(),
+        };
+        let _ = writeln!(
+            out,
+            "{head} hertz/material {} {} {} damping {} {tangential}{}{tail}",
+            fmt_num(self.youngs),
+            fmt_num(self.damp),
+            fmt_num(self.nu),
+            self.damping,
+            if self.force_rule {
+                " limit_damping"
+            } else {
+                ""
+            },
+        );
+    }
 }
 
 /// Writes in.restitution and collide.in for the translation `tr` and the law `law`, with
@@ -186,32 +194,23 @@ pub fn lammps_files(
     let mut wall_lines = String::new();
     for (p, pair) in tr.pairs.iter().enumerate() {
         let b: &LammpsViscoelastic = &base[p];
+        let coeff = Coeff {
+            youngs: b.youngs_pa,
+            damp: damps[p],
+            nu: b.poisson,
+            damping,
+            kt: b.kt_pa,
+            friction,
+            force_rule,
+        };
         match pair.j {
-            Some(j) => coeff_line(
-                &mut f,
-                &format!("pair_coeff {} {}", pair.i + 1, j + 1),
-                b.youngs_pa,
-                damps[p],
-                b.poisson,
-                damping,
-                b.kt_pa,
-                friction,
-                force_rule,
-                "",
-            ),
+            Some(j) => coeff.write(&mut f, &format!("pair_coeff {} {}", pair.i + 1, j + 1), ""),
             None => {
                 let t = pair.i + 1;
                 let _ = writeln!(wall_lines, "group restitution_t{t} type {t}");
-                coeff_line(
+                coeff.write(
                     &mut wall_lines,
                     &format!("fix restitution_wall_t{t} restitution_t{t} wall/gran granular"),
-                    b.youngs_pa,
-                    damps[p],
-                    b.poisson,
-                    damping,
-                    b.kt_pa,
-                    friction,
-                    force_rule,
                     " ${restitution_wall}",
                 );
             }
@@ -415,160 +414,4 @@ fn collide_input(
         );
     }
     Ok(s)
-}
-
-/// One collision's check: LAMMPS's e (phase mean) at each rung of the step ladder, the
-/// extrapolation to a zero step, and the toolkit's e.
-#[derive(Debug, Clone, PartialEq)]
-pub struct VerifyRow {
-    pub pair: String,
-    pub v_m_s: f64,
-    pub e_toolkit: f64,
-    /// (steps per shortest contact, mean e over the phases).
-    pub rungs: Vec<(u32, f64)>,
-    /// Richardson extrapolation from the two finest rungs.
-    pub e_extrapolated: f64,
-    /// How much the extrapolation moved between the last two pairs of rungs (an error estimate;
-    /// 0 with only two rungs).
-    pub extrapolation_change: f64,
-}
-
-impl VerifyRow {
-    pub fn difference(&self) -> f64 {
-        self.e_extrapolated - self.e_toolkit
-    }
-}
-
-/// Runs `lmp` on DIR/collide.in with `-var steps N`, returning its standard output.
-pub fn run_lmp(dir: &Path, steps: u32) -> Result<String, String> {
-    let out = Command::new("lmp")
-        .current_dir(dir)
-        .args([
-            "-nocite",
-            "-log",
-            "none",
-            "-echo",
-            "none",
-            "-in",
-            "collide.in",
-        ])
-        .args(["-var", "steps", &steps.to_string()])
-        .output()
-        .map_err(|e| {
-            if e.kind() == std::io::ErrorKind::NotFound {
-                "lmp (LAMMPS) is not on PATH: install it (Debian/Ubuntu: apt-get install lammps) \
-                 or run collide.in yourself"
-                    .to_string()
-            } else {
-                format!("cannot run lmp: {e}")
-            }
-        })?;
-    let text = String::from_utf8_lossy(&out.stdout).to_string();
-    if !out.status.success() {
-        let msg = text
-            .lines()
-            .chain(String::from_utf8_lossy(&out.stderr).lines())
-            .find(|l| l.contains("ERROR"))
-            .unwrap_or("no ERROR line")
-            .to_string();
-        return Err(format!(
-            "lmp failed on {}/collide.in ({}): {msg}",
-            dir.display(),
-            out.status
-        ));
-    }
-    Ok(text)
-}
-
-/// The phase means per (pair, speed) from collide.in's output, checking that every collision
-/// ended (positive gap) and printed a number.
-pub fn parse_collide_output(text: &str) -> Result<BTreeMap<(String, String), f64>, String> {
-    let mut sums: BTreeMap<(String, String), (f64, usize)> = BTreeMap::new();
-    for line in text.lines() {
-        let Some(rest) = line.strip_prefix("restitution-e ") else {
-            continue;
-        };
-        let kv: BTreeMap<&str, &str> = rest
-            .split_whitespace()
-            .filter_map(|w| w.split_once('='))
-            .collect();
-        let get = |k: &str| {
-            kv.get(k)
-                .copied()
-                .ok_or_else(|| format!("collide.in output line without '{k}': {line}"))
-        };
-        let e: f64 = get("e")?
-            .parse()
-            .map_err(|_| format!("collide.in printed a non-number e: {line}"))?;
-        let gap: f64 = get("gap_m")?
-            .parse()
-            .map_err(|_| format!("collide.in printed a non-number gap: {line}"))?;
-        if !e.is_finite() {
-            return Err(format!("collide.in printed e = {e}: {line}"));
-        }
-        if !(gap > 0.0) {
-            return Err(format!(
-                "a collision had not ended when the run stopped (gap {gap} m): {line}"
-            ));
-        }
-        let entry = sums
-            .entry((get("pair")?.to_string(), get("v_m_s")?.to_string()))
-            .or_insert((0.0, 0));
-        entry.0 += e;
-        entry.1 += 1;
-    }
-    if sums.is_empty() {
-        return Err("collide.in printed no restitution-e lines".into());
-    }
-    Ok(sums
-        .into_iter()
-        .map(|(k, (s, n))| (k, s / n as f64))
-        .collect())
-}
-
-/// The round trip: runs collide.in at every rung of `ladder` (steps per shortest contact, each
-/// twice the previous) and compares the extrapolated e with the toolkit's.
-pub fn verify(
-    dir: &Path,
-    tr: &Translation,
-    collisions: &[Collision],
-    ladder: &[u32],
-) -> Result<Vec<VerifyRow>, String> {
-    if ladder.len() < 2 || ladder.windows(2).any(|w| w[1] != 2 * w[0]) {
-        return Err("the step ladder needs at least two rungs, each twice the last".into());
-    }
-    let mut runs = Vec::new();
-    for &n in ladder {
-        runs.push((n, parse_collide_output(&run_lmp(dir, n)?)?));
-    }
-    let mut rows = Vec::new();
-    for col in collisions {
-        let key = (tr.pairs[col.pair].label(), fmt_num(col.v_m_s));
-        let mut rungs = Vec::new();
-        for (n, means) in &runs {
-            let e = means.get(&key).ok_or_else(|| {
-                format!(
-                    "collide.in printed nothing for pair {} at {} m/s",
-                    key.0, key.1
-                )
-            })?;
-            rungs.push((*n, *e));
-        }
-        let k = rungs.len();
-        let last = richardson_first_order(rungs[k - 2].1, rungs[k - 1].1);
-        let change = if k >= 3 {
-            (last - richardson_first_order(rungs[k - 3].1, rungs[k - 2].1)).abs()
-        } else {
-            0.0
-        };
-        rows.push(VerifyRow {
-            pair: key.0,
-            v_m_s: col.v_m_s,
-            e_toolkit: col.e,
-            rungs,
-            e_extrapolated: last,
-            extrapolation_change: change,
-        });
-    }
-    Ok(rows)
 }
