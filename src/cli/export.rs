@@ -254,6 +254,12 @@ pub fn run(a: Args) -> CliResult {
             a.table_points
         ));
     }
+    if a.v_range.is_none() && curve.kind != ModelKind::Vm {
+        return Err(format!(
+            "model {} has no exact engine form: give the scene's speeds with --v-range LO,HI",
+            curve.kind
+        ));
+    }
     if a.engine != Engine::Lammps && a.v_range.is_none() {
         return Err("this engine needs the scene's speeds: --v-range LO,HI".into());
     }

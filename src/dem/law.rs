@@ -7,6 +7,7 @@ use crate::contact::Contact;
 use crate::error::{Error, Result};
 use crate::fit::lsq::brent_minimize;
 use crate::fit::models::{ModelKind, e_vm, predict_e};
+use crate::models::viscoelastic::master::KAPPA_MAX;
 use crate::models::viscoelastic::{ContactEnd, VmMethod};
 
 /// A fitted e(v): one of the fit's models with its parameters (SI units, in the order of
@@ -188,7 +189,8 @@ const ETA_SCAN: usize = 61;
 /// The closest viscoelastic law; see [`ViscoelasticFit`].
 ///
 /// **Method**: each objective is scanned on [`ETA_SCAN`] values of ln eta spanning the dampings
-/// for which kappa runs from 1e-7 (e = 1 - 1e-7) to 30 (e ~ 1e-7) somewhere in the scene, then
+/// for which kappa runs from 1e-7 (e = 1 - 1e-7) to 30 (e ~ 1e-7) somewhere in the scene (capped
+/// at kappa = 100 everywhere), then
 /// polished by Brent's method (argmin) between the neighbours of the best grid point. The
 /// least-squares objective uses the quadrature nodes of [`super::range::nodes`]; the minimax one
 /// a 200-point grid in ln v per pair, and its reported deviation is then re-measured with
@@ -265,7 +267,13 @@ pub fn viscoelastic_fit(
         .collect();
     let k_min = per_eta.iter().cloned().fold(f64::INFINITY, f64::min);
     let k_max = per_eta.iter().cloned().fold(0.0, f64::max);
-    let (a, b) = ((1e-7 / k_max).ln(), (30.0 / k_min).ln());
+    // Upper end: kappa = 30 at the least damped point (e ~ 1e-7 there), but never beyond the
+    // master curve's kappa <= 100 anywhere (beyond it e falls back to the ODE, 1000 times slower,
+    // for dampings that leave e < 1e-5 at that point and so can never be the best law).
+    let (a, b) = (
+        (1e-7 / k_max).ln(),
+        (30.0 / k_min).min(KAPPA_MAX / k_max).ln(),
+    );
     let mut converged = true;
     let mut minimise = |f: &dyn Fn(f64) -> Result<f64>| -> Result<f64> {
         let grid: Vec<f64> = (0..ETA_SCAN)
