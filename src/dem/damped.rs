@@ -84,6 +84,8 @@ pub struct DampedRebound {
     pub one_minus_e: f64,
     /// Contact duration in units of T (see the module note).
     pub tau_contact: f64,
+    /// Overlap at the end of contact in units of L = V T (0 for the overlap rule).
+    pub x_end: f64,
 }
 
 type Y = [f64; 3];
@@ -293,6 +295,7 @@ pub fn rebound(
         e,
         one_minus_e,
         tau_contact: tau,
+        x_end,
     })
 }
 

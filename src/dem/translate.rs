@@ -11,7 +11,7 @@ use super::range::{SpeedRange, Weight};
 use super::scene::{Scene, ScenePair};
 use crate::error::{Error, Result};
 use crate::fit::models::e_vm;
-use crate::models::viscoelastic::{ContactEnd, VmMethod};
+use crate::models::viscoelastic::{ContactEnd, OdeSettings, Viscoelastic, VmMethod};
 
 /// What a scene asks of the translation.
 #[derive(Debug, Clone, PartialEq)]
@@ -208,12 +208,15 @@ pub struct Collision {
     pub v_m_s: f64,
     /// e of the law (what the engine must reproduce).
     pub e: f64,
-    /// How long the contact lasts, s.
+    /// How long the contact force acts, s.
     pub contact_time_s: f64,
+    /// When the surfaces separate, s: later than the contact's end under the force rule, where
+    /// the spheres still overlap (x_end) when the force vanishes and part at speed e v.
+    pub separation_time_s: f64,
 }
 
 impl Translation {
-    /// e and contact duration of the exported law for every pair at every speed (ODE for the
+    /// e, contact duration and separation time of the exported law for every pair at every speed (ODE for the
     /// viscoelastic law, [`damped::rebound`] for Tsuji's).
     pub fn collisions(&self, law: &EngineLaw, speeds: &[f64]) -> Result<Vec<Collision>> {
         let rule = self.request.curve.rule;
@@ -221,28 +224,29 @@ impl Translation {
         for (p, pair) in self.pairs.iter().enumerate() {
             for &v in speeds {
                 crate::error::positive("collision speed (m/s)", v)?;
-                let (e, contact_time_s) = match law {
+                // e, the contact duration (units of T) and the overlap left when it ends (V T).
+                let (e, tau, x_end) = match law {
                     EngineLaw::Viscoelastic { eta } => {
-                        let im =
-                            crate::models::viscoelastic::Viscoelastic::new(pair.contact, *eta)?
-                                .impact(
-                                    v,
-                                    rule,
-                                    &crate::models::viscoelastic::OdeSettings::DEFAULT,
-                                )?;
-                        (im.e, im.contact_time_s)
+                        let im = Viscoelastic::new(pair.contact, *eta)?.impact(
+                            v,
+                            rule,
+                            &OdeSettings::DEFAULT,
+                        )?;
+                        (im.e, im.dimensionless.tau_contact, im.dimensionless.x_end)
                     }
                     EngineLaw::Tsuji { alpha } => {
                         let r =
                             damped::rebound(alpha[p], Dashpot::Tsuji, rule, damped::DEFAULT_STEPS)?;
-                        (r.e, r.tau_contact * pair.contact.time_scale_s(v))
+                        (r.e, r.tau_contact, r.x_end)
                     }
                 };
+                let t = pair.contact.time_scale_s(v);
                 out.push(Collision {
                     pair: p,
                     v_m_s: v,
                     e,
-                    contact_time_s,
+                    contact_time_s: tau * t,
+                    separation_time_s: (tau + x_end / e) * t,
                 });
             }
         }

@@ -250,16 +250,16 @@ fn collide_input(
         .iter()
         .map(|c| c.contact_time_s)
         .fold(f64::INFINITY, f64::min);
-    let tc_max = collisions
+    let t_sep_max = collisions
         .iter()
-        .map(|c| c.contact_time_s)
+        .map(|c| c.separation_time_s)
         .fold(0.0, f64::max);
     if !(tc_min.is_finite() && tc_min > 0.0) {
         return Err("no collision to write".into());
     }
     // The contact starts 10 to 11 steps after the run starts (see the gaps below); 20% beyond the
-    // longest contact leaves every pair separated at the end, which collide.in prints as a gap.
-    let t_run = 1.2 * tc_max;
+    // latest separation leaves every pair apart at the end, which collide.in prints as a gap.
+    let t_run = 1.2 * t_sep_max;
     let spacing = 4.0 * d_max + 0.01;
     let n_coll = collisions.len() * PHASES;
     let per_row = (n_coll as f64).sqrt().ceil() as usize;

@@ -9,6 +9,7 @@ use crate::dem::translate::{Collision, Translation};
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Command;
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// One collision's check: LAMMPS's e (phase mean) at each rung of the step ladder, the
 /// extrapolation to a zero step, and the toolkit's e.
@@ -173,7 +174,13 @@ pub fn verify_files(
     lf: &LammpsFiles,
     ladder: &[u32],
 ) -> Result<Vec<VerifyRow>, String> {
-    let dir = std::env::temp_dir().join(format!("restitution-verify-{}", std::process::id()));
+    // Unique per process and call: verifications may run concurrently (threads, tests).
+    static CALLS: AtomicUsize = AtomicUsize::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "restitution-verify-{}-{}",
+        std::process::id(),
+        CALLS.fetch_add(1, Ordering::SeqCst)
+    ));
     std::fs::create_dir_all(&dir)
         .map_err(|e| format!("{}: cannot create the directory: {e}", dir.display()))?;
     let scratch = [
