@@ -215,7 +215,7 @@ fn tsuji_polynomial_given_e_itself() {
     if !lmp_available() {
         return;
     }
-    // Asked for e directly, LAMMPS uses alpha = poly(e), which is 1/sqrt(2) of the alpha that
+    // Asked for e directly, LAMMPS uses alpha = poly(e), 0.34-0.71 of the alpha that
     // gives e. The toolkit predicts what it gives (the Tsuji ODE at poly(e)), and LAMMPS must
     // agree with that prediction while missing the requested e by 0.01 or more. Force rule:
     // limit_damping.

@@ -162,8 +162,8 @@ pub fn lammps_files(
         LammpsLaw::Tsuji { .. } => {
             let _ = writeln!(
                 f,
-                "# damping tsuji turns its coefficient into alpha with a polynomial whose alpha is\n\
-                 # 1/sqrt(2) of the exact one (docs/physics.md §9): the coefficients below are not the\n\
+                "# damping tsuji turns its coefficient into alpha with a polynomial whose alpha is about\n\
+                 # 0.7 of the one that gives e (docs/physics.md §9): the coefficients below are not the\n\
                  # e you want but the inputs that make LAMMPS produce it (see constant_e.csv)."
             );
         }

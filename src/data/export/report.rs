@@ -145,6 +145,16 @@ pub fn report(s: &Summary) -> String {
             );
         }
     }
+    if let Some(law) = s.lammps_law {
+        let note = match law {
+            super::lammps::LammpsLaw::Viscoelastic { note, .. }
+            | super::lammps::LammpsLaw::Tsuji { note, .. } => note,
+        };
+        let _ = writeln!(
+            o,
+            "\nLAMMPS files (in.restitution, collide.in) carry {note}"
+        );
+    }
     if let Some(f) = s.friction {
         let _ = writeln!(
             o,

@@ -196,3 +196,26 @@ pub fn verify_files(
     let _ = std::fs::remove_dir_all(&dir);
     result
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn collide_output_is_averaged_and_checked() {
+        let ok = "noise\nrestitution-e pair=1-2 v_m_s=2 phase=0 e=0.5 gap_m=1e-3\n\
+                  restitution-e pair=1-2 v_m_s=2 phase=1 e=0.7 gap_m=2e-3\n\
+                  restitution-e-mean pair=1-2 v_m_s=2 e=0.6 toolkit_e=0.6\n";
+        let m = parse_collide_output(ok).unwrap();
+        assert_eq!(m[&("1-2".to_string(), "2".to_string())], 0.6);
+        for bad in [
+            "restitution-e pair=1-1 v_m_s=2 phase=0 e=0.5 gap_m=-1e-6",
+            "restitution-e pair=1-1 v_m_s=2 phase=0 e=nan gap_m=1e-6",
+            "restitution-e pair=1-1 v_m_s=2 phase=0 e=x gap_m=1e-6",
+            "restitution-e pair=1-1 v_m_s=2 phase=0 gap_m=1e-6",
+            "nothing here",
+        ] {
+            assert!(parse_collide_output(bad).is_err(), "{bad}");
+        }
+    }
+}
