@@ -32,3 +32,21 @@ $B simulate --material nylon --camera-study --incidence-deg 0,45 --out reports/k
 
 # Bench (issue 4): work-precision chart, stability map, fit accuracy, targets (timings vary by machine).
 $B bench --out reports/bench > /dev/null
+
+# Export (DEM): the shipped fits as engine inputs. With lmp (LAMMPS) on PATH the LAMMPS exports
+# are run through it (--verify, about 15 s each); report.txt holds what the command printed.
+VERIFY=""
+if command -v lmp > /dev/null 2>&1; then VERIFY="--verify"; fi
+mkdir -p reports/export/lammps_vm reports/export/lammps_min reports/export/lammps_force \
+    reports/export/constant_e reports/export/table
+$B export reports/fit/params.json --engine lammps --model vm --walton reports/walton/walton.json \
+    --wall --out reports/export/lammps_vm $VERIFY > reports/export/lammps_vm/report.txt
+$B export reports/fit/params.json --engine lammps --v-range 0.5,40 --tolerance 0.01 \
+    --walton reports/walton/walton.json --out reports/export/lammps_min > reports/export/lammps_min/report.txt
+$B export reports/fit/params.json --engine constant-e --v-range 0.5,2 --tolerance 0.02 \
+    --walton reports/walton/walton.json --out reports/export/constant_e $VERIFY > reports/export/constant_e/report.txt
+$B export --engine lammps --material nylon --d-mm 6.35,25.4 --wall --eta 2000 --contact-end force \
+    --speeds 0.5,3,20 --out reports/export/lammps_force $VERIFY > reports/export/lammps_force/report.txt
+$B export reports/fit/params.json --engine table --v-range 0.5,40 --walton reports/walton/walton.json \
+    --out reports/export/table > reports/export/table/report.txt
+cargo run --release --quiet --example tsuji_accuracy > reports/export/tsuji_accuracy.txt

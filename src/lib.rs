@@ -4,6 +4,7 @@
 pub mod bench;
 pub mod contact;
 pub mod data;
+pub mod dem;
 pub mod error;
 pub mod experiment;
 pub mod fit;

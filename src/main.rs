@@ -30,6 +30,8 @@ enum Command {
     Simulate(cli::simulate::Args),
     /// Walton's collision operator: fit e, beta_0 and mu_0 to oblique collisions (Fig. 6)
     Walton(cli::walton::Args),
+    /// A fitted contact law as simulation-engine input (LAMMPS, constant-e engines, tables)
+    Export(cli::export::Args),
 }
 
 /// Whether a panic is the standard library's `print!` failing on a closed stdout or stderr (the
@@ -87,6 +89,7 @@ fn main() -> ExitCode {
         Command::Walton(args) => cli::walton::run(args),
         Command::Kinematics(args) => cli::kinematics::run(args),
         Command::Simulate(args) => cli::simulate::run(args),
+        Command::Export(args) => cli::export::run(args),
     });
     match run {
         Ok(Ok(())) => ExitCode::SUCCESS,

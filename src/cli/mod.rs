@@ -5,6 +5,7 @@ use restitution::contact::{Material, PRESETS};
 use std::io::{self, Write};
 
 pub mod bench;
+pub mod export;
 pub mod fit;
 pub mod kinematics;
 pub mod predict;

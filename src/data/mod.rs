@@ -10,6 +10,7 @@
 //! in shortest round-trip form ([`fmt_num`]), and every output file through [`write_atomic`] or
 //! [`write_all_atomic`].
 
+pub mod export;
 mod table;
 pub mod tracks;
 pub mod walton;

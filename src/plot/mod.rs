@@ -42,6 +42,7 @@ pub fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
         .map_err(|e| format!("drawing a legend: {e}"))
 }
 
+pub mod export;
 pub mod fit;
 pub mod kinematics;
 pub mod walton;

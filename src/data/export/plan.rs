@@ -1,0 +1,201 @@
+//! Which files an export writes and what they carry: the engine's law (exact, closest
+//! viscoelastic or constant e), the LAMMPS inputs, the constant-e and table files.
+
+use super::files::{self, Summary};
+use super::lammps::{self, Friction, LammpsFiles, LammpsLaw};
+use crate::data::fmt_num;
+use crate::dem::range::SpeedRange;
+use crate::dem::translate::{ConstantEInputs, Translation, constant_e_inputs};
+
+/// The engine family the user exports for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EngineKind {
+    Lammps,
+    ConstantE,
+    Table,
+}
+
+impl EngineKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            EngineKind::Lammps => "lammps",
+            EngineKind::ConstantE => "constant-e",
+            EngineKind::Table => "table",
+        }
+    }
+}
+
+/// Which law the LAMMPS files carry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LawChoice {
+    /// The exact law for `vm`; otherwise the closer of the other two (largest deviation of the
+    /// exported values: least-squares eta, weighted-mean constant e).
+    Auto,
+    Viscoelastic,
+    ConstantE,
+}
+
+/// Collision speeds of collide.in when the user gives none: the range's ends and geometric
+/// middle, or 0.5, 2 and 10 m/s without a range (named in collide.in's comments).
+pub fn default_speeds(range: Option<SpeedRange>) -> Vec<f64> {
+    match range {
+        Some(r) => vec![r.lo_m_s, (r.lo_m_s * r.hi_m_s).sqrt(), r.hi_m_s],
+        None => vec![0.5, 2.0, 10.0],
+    }
+}
+
+/// An export ready to write: the files (name, bytes) and what the report needs.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    pub engine: EngineKind,
+    pub lammps_law: Option<LammpsLaw>,
+    pub lammps_files: Option<LammpsFiles>,
+    /// Engine inputs for each pair's constant e (shown for the constant-e engine).
+    pub constant_inputs: Option<Vec<ConstantEInputs>>,
+    pub outputs: Vec<(String, Vec<u8>)>,
+}
+
+/// Builds the files of an export (everything but the figure and export.json, which
+/// [`Plan::summary`] and the plot module give).
+pub fn plan(
+    tr: &Translation,
+    engine: EngineKind,
+    law: LawChoice,
+    friction: Option<&Friction>,
+    speeds: &[f64],
+    source: &str,
+) -> Result<Plan, String> {
+    let rule = tr.request.curve.rule;
+    let needs_constant = engine == EngineKind::ConstantE
+        || (engine == EngineKind::Lammps && law != LawChoice::Viscoelastic);
+    let const_inputs = match (&tr.constant, needs_constant) {
+        (Some(c), true) => Some(
+            c.iter()
+                .map(|x| constant_e_inputs(x.e_mean, rule))
+                .collect::<Result<Vec<_>, _>>()
+                .map_err(|e| format!("constant e: {e}"))?,
+        ),
+        _ => None,
+    };
+    let tsuji_law = |note: String| -> Result<LammpsLaw, String> {
+        let inputs = const_inputs
+            .as_ref()
+            .ok_or("a constant e needs the scene's speeds (--v-range)")?;
+        Ok(LammpsLaw::Tsuji {
+            // The polynomial cannot ask for less damping than at cor = 1 (e above 0.99958):
+            // then cor = 1, and collide.in's expected e says what LAMMPS gives instead.
+            cor: inputs.iter().map(|i| i.lammps_cor.unwrap_or(1.0)).collect(),
+            note,
+        })
+    };
+    let vm = &tr.viscoelastic;
+    let kind = tr.request.curve.kind;
+    let lammps_law = match engine {
+        EngineKind::Table => None,
+        EngineKind::ConstantE => Some(tsuji_law(
+            "Hertz with Tsuji's damping, a constant e per pair (the weighted mean of the fitted \
+             e(v) over the speed range; constant_e.csv)"
+                .into(),
+        )?),
+        EngineKind::Lammps => {
+            let const_dev = tr
+                .constant
+                .as_ref()
+                .map(|c| c.iter().map(|x| x.dev_mean).fold(0.0, f64::max));
+            let use_const = match law {
+                LawChoice::Viscoelastic => false,
+                LawChoice::ConstantE => true,
+                LawChoice::Auto => !vm.exact && const_dev.is_some_and(|d| d < vm.dev_mean),
+            };
+            Some(if use_const {
+                tsuji_law(format!(
+                    "a constant e per pair (largest deviation from the fitted {kind} curve {:.3e}; \
+                     the closest viscoelastic law would deviate by {:.3e})",
+                    const_dev.unwrap_or(f64::NAN),
+                    vm.dev_mean
+                ))?
+            } else if vm.exact {
+                LammpsLaw::Viscoelastic {
+                    eta: vm.eta_mean,
+                    note: format!(
+                        "Hertz + viscoelastic damping (Eqs. 9-10) with the fitted eta = {} kg/(s m): exact",
+                        fmt_num(vm.eta_mean)
+                    ),
+                }
+            } else {
+                LammpsLaw::Viscoelastic {
+                    eta: vm.eta_mean,
+                    note: format!(
+                        "the viscoelastic law closest to the fitted {kind} curve (eta = {} kg/(s m), \
+                         least squares over the speed range): largest deviation {:.3e}{}",
+                        fmt_num(vm.eta_mean),
+                        vm.dev_mean,
+                        const_dev
+                            .map(|d| format!("; a constant e would deviate by {d:.3e}"))
+                            .unwrap_or_default()
+                    ),
+                }
+            })
+        }
+    };
+
+    let mut outputs: Vec<(String, Vec<u8>)> = Vec::new();
+    let mut lammps_files = None;
+    if let Some(l) = &lammps_law {
+        let lf = lammps::lammps_files(tr, l, friction, speeds, source)?;
+        outputs.push((
+            "in.restitution".into(),
+            lf.in_restitution.clone().into_bytes(),
+        ));
+        outputs.push(("collide.in".into(), lf.collide_in.clone().into_bytes()));
+        lammps_files = Some(lf);
+    }
+    let constant_inputs = if engine == EngineKind::ConstantE {
+        const_inputs
+    } else {
+        None
+    };
+    if let Some(inputs) = &constant_inputs {
+        outputs.push((
+            "constant_e.csv".into(),
+            files::constant_e_csv(tr, inputs)?.into_bytes(),
+        ));
+        outputs.push((
+            "liggghts.in".into(),
+            files::liggghts_input(tr, inputs, friction).into_bytes(),
+        ));
+    }
+    if engine == EngineKind::Table {
+        outputs.push(("table.csv".into(), files::table_csv(tr)?.into_bytes()));
+    }
+    Ok(Plan {
+        engine,
+        lammps_law,
+        lammps_files,
+        constant_inputs,
+        outputs,
+    })
+}
+
+impl Plan {
+    /// What the report and export.json say about this plan.
+    pub fn summary<'a>(
+        &'a self,
+        tr: &'a Translation,
+        source: &'a str,
+        friction: Option<&'a Friction>,
+        files: Vec<String>,
+        verify: Option<&'a [super::run::VerifyRow]>,
+    ) -> Summary<'a> {
+        Summary {
+            source,
+            engine: self.engine.name(),
+            tr,
+            lammps_law: self.lammps_law.as_ref(),
+            constant_inputs: self.constant_inputs.as_deref(),
+            friction,
+            files,
+            verify,
+        }
+    }
+}

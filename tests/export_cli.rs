@@ -1,0 +1,569 @@
+//! `restitution export` as a user runs it: the files each engine writes, the LAMMPS numbers
+//! checked against values computed here from the formulas (not by the code under test), and one
+//! clear line, a non-zero exit and no output files per bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+const BIN: &str = env!("CARGO_BIN_EXE_restitution");
+
+struct Run {
+    ok: bool,
+    stdout: String,
+    stderr: String,
+}
+
+fn run(args: &[&str]) -> Run {
+    let out = Command::new(BIN)
+        .args(args)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        // --verify must not find a LAMMPS here: the bad-input tests never reach it anyway.
+        .output()
+        .expect("binary runs");
+    Run {
+        ok: out.status.success(),
+        stdout: String::from_utf8_lossy(&out.stdout).into(),
+        stderr: String::from_utf8_lossy(&out.stderr).into(),
+    }
+}
+
+fn scratch(tag: &str) -> PathBuf {
+    static N: AtomicUsize = AtomicUsize::new(0);
+    let d = std::env::temp_dir().join(format!(
+        "restitution-export-cli-{}-{}-{tag}",
+        std::process::id(),
+        N.fetch_add(1, Ordering::SeqCst)
+    ));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.to_string_lossy().into()
+}
+
+fn read(dir: &Path, name: &str) -> String {
+    std::fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+#[test]
+fn lammps_export_of_the_shipped_vm_fit() {
+    let out = scratch("vm");
+    let o = out.to_string_lossy().to_string();
+    let r = run(&[
+        "export",
+        "reports/fit/params.json",
+        "--engine",
+        "lammps",
+        "--model",
+        "vm",
+        "--walton",
+        "reports/walton/walton.json",
+        "--wall",
+        "--out",
+        &o,
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    assert!(
+        r.stdout.contains("0 (the fitted model itself)"),
+        "{}",
+        r.stdout
+    );
+    let f = read(&out, "in.restitution");
+    let json: serde_json::Value = serde_json::from_str(&read(&out, "export.json")).unwrap();
+    let eta = json["viscoelastic"]["eta_mean"].as_f64().unwrap();
+    // The fitted eta of reports/fit/params.json (vm).
+    assert!((eta - 247.23777577591557).abs() < 1e-12);
+    // Every pair of the three sizes, written out (no mixing), and one wall fix per size.
+    let lines: Vec<&str> = f.lines().filter(|l| l.starts_with("pair_coeff")).collect();
+    assert_eq!(lines.len(), 6, "{f}");
+    assert_eq!(f.matches("wall/gran granular").count(), 3);
+    // damp = 4 eta / m_red with m = (pi/6) d^3 rho: computed here from the sizes.
+    let mass = |d: f64| std::f64::consts::PI / 6.0 * d.powi(3) * 1140.0;
+    let d = [6.35e-3, 12.7e-3, 25.4e-3];
+    let mut k = 0;
+    for i in 0..3 {
+        for j in i..3 {
+            let (mi, mj) = (mass(d[i]), mass(d[j]));
+            let want = 4.0 * eta * (mi + mj) / (mi * mj);
+            let fields: Vec<&str> = lines[k].split_whitespace().collect();
+            assert_eq!(fields[1..3], [&*(i + 1).to_string(), &*(j + 1).to_string()]);
+            assert_eq!(fields[3], "hertz/material");
+            assert_eq!(fields[4], "350000000");
+            let damp: f64 = fields[5].parse().unwrap();
+            assert!(
+                (damp / want - 1.0).abs() < 1e-14,
+                "{}: {damp} vs {want}",
+                lines[k]
+            );
+            assert_eq!(fields[6], "0.3");
+            // Mindlin k_t = 8 G*, G* = G/(2 (2 - nu)), G = Y/(2 (1 + nu)); mu_0 from walton.json.
+            let kt: f64 = fields[11].parse().unwrap();
+            assert!((kt / (8.0 * 3.5e8 / 2.6 / 3.4) - 1.0).abs() < 1e-14);
+            assert_eq!(fields[13], "0.17469876337247983");
+            assert!(!lines[k].contains("limit_damping"), "overlap rule");
+            k += 1;
+        }
+    }
+    // The wall fix of type 1: damp = 4 eta / m, modulus 2 (1 - nu) E* with E* = Y/(2 (1 - nu^2)).
+    let wall = f
+        .lines()
+        .find(|l| l.starts_with("fix restitution_wall_t1"))
+        .unwrap();
+    let w: Vec<&str> = wall.split_whitespace().collect();
+    let e_star = 3.5e8 / (2.0 * 0.91);
+    assert!((w[6].parse::<f64>().unwrap() / (1.4 * e_star) - 1.0).abs() < 1e-14);
+    assert!((w[7].parse::<f64>().unwrap() / (4.0 * eta / mass(d[0])) - 1.0).abs() < 1e-14);
+    let collide = read(&out, "collide.in");
+    assert!(collide.contains("include in.restitution"));
+    // 9 contacts x 3 speeds x 8 phases print lines, and one mean per contact and speed.
+    assert_eq!(collide.matches("print \"restitution-e ").count(), 9 * 3 * 8);
+    assert_eq!(collide.matches("print \"restitution-e-mean").count(), 27);
+}
+
+#[test]
+fn force_rule_writes_limit_damping() {
+    let out = scratch("force");
+    let o = out.to_string_lossy().to_string();
+    let r = run(&[
+        "export",
+        "--engine",
+        "lammps",
+        "--material",
+        "nylon",
+        "--d-mm",
+        "6.35,25.4",
+        "--eta",
+        "190",
+        "--contact-end",
+        "force",
+        "--out",
+        &o,
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let f = read(&out, "in.restitution");
+    let coeffs: Vec<&str> = f.lines().filter(|l| l.starts_with("pair_coeff")).collect();
+    assert_eq!(coeffs.len(), 3);
+    assert!(coeffs.iter().all(|l| l.ends_with("limit_damping")), "{f}");
+    assert!(
+        f.contains("tangential linear_nohistory 0 0"),
+        "no friction given: frictionless"
+    );
+}
+
+#[test]
+fn constant_e_and_table_engines() {
+    let out = scratch("const");
+    let o = out.to_string_lossy().to_string();
+    let r = run(&[
+        "export",
+        "reports/fit/params.json",
+        "--engine",
+        "constant-e",
+        "--v-range",
+        "0.5,2",
+        "--tolerance",
+        "0.02",
+        "--out",
+        &o,
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    // Below yield the min model's e varies by at most 0.024 over 0.5-2 m/s: within 0.02 of a
+    // constant (minimax half-range 0.012), so no velocity dependence is needed.
+    assert!(
+        r.stdout.contains("simplest law within 0.0200: constant e"),
+        "{}",
+        r.stdout
+    );
+    let csv = read(&out, "constant_e.csv");
+    assert_eq!(csv.lines().count(), 1 + 6);
+    assert!(read(&out, "in.restitution").contains("damping tsuji"));
+    assert!(read(&out, "liggghts.in").contains("coefficientRestitution peratomtypepair 3"));
+    assert!(read(&out, "laws.svg").starts_with("<svg"));
+
+    let out = scratch("table");
+    let o = out.to_string_lossy().to_string();
+    let r = run(&[
+        "export",
+        "reports/fit/params.json",
+        "--engine",
+        "table",
+        "--v-range",
+        "0.5,40",
+        "--table-points",
+        "11",
+        "--walton",
+        "reports/walton/walton.json",
+        "--out",
+        &o,
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let t = read(&out, "table.csv");
+    assert_eq!(t.lines().next(), Some("pair,d1_mm,d2_mm,v_n_m_s,e"));
+    assert_eq!(t.lines().count(), 1 + 6 * 11);
+    let json: serde_json::Value = serde_json::from_str(&read(&out, "export.json")).unwrap();
+    assert_eq!(json["friction"]["beta0"].as_f64(), Some(0.4946949064230879));
+    assert!(!out.join("in.restitution").exists());
+}
+
+#[test]
+fn params_json_with_unknown_fields_is_read() {
+    // Someone may add per-model `warnings` (or anything else): ignored.
+    let dir = scratch("unknown");
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/fit/params.json"),
+    )
+    .unwrap()
+    .replace(
+        "\"notes\": []",
+        "\"notes\": [], \"warnings\": [\"something\"], \"extra\": {\"x\": 1}",
+    );
+    assert!(text.contains("warnings"));
+    let p = write(&dir, "params.json", &text);
+    let r = run(&["export", &p, "--engine", "lammps", "--model", "vm"]);
+    assert!(r.ok, "{}", r.stderr);
+    assert!(r.stdout.contains("--- in.restitution ---"));
+}
+
+/// Runs a bad command: it must fail with one line on stderr containing `want`, and leave the
+/// output directory empty.
+fn refuses(args: &[&str], want: &str) {
+    let out = scratch("bad");
+    let o = out.to_string_lossy().to_string();
+    let mut full: Vec<&str> = args.to_vec();
+    full.extend(["--out", &o]);
+    let r = run(&full);
+    assert!(!r.ok, "{args:?} succeeded:\n{}", r.stdout);
+    let lines: Vec<&str> = r.stderr.lines().collect();
+    assert_eq!(lines.len(), 1, "{args:?}: {}", r.stderr);
+    assert!(lines[0].contains(want), "{args:?}: {}", r.stderr);
+    assert_eq!(
+        std::fs::read_dir(&out).unwrap().count(),
+        0,
+        "{args:?} wrote files"
+    );
+}
+
+#[test]
+fn bad_input_gives_one_clear_line_and_no_files() {
+    let dir = scratch("inputs");
+    let garbled = write(
+        &dir,
+        "garbled.json",
+        "{\n  \"material\": {\n    \"youngs_pa\": 3.5e8,,\n",
+    );
+    let wrong = write(
+        &dir,
+        "wrong.json",
+        "{\"material\": {\"youngs_pa\": \"hard\"}}",
+    );
+    let params = "reports/fit/params.json";
+    let bound_json = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/fit/params.json"),
+    )
+    .unwrap()
+    .replacen("\"value\": 40222038.478004314", "\"value\": null", 1)
+    .replacen(
+        "\"status\": \"estimate\",\n          \"best_fit\": 40222038",
+        "\"status\": \"lower_bound\",\n          \"best_fit\": 40222038",
+        1,
+    );
+    let bound = write(&dir, "bound.json", &bound_json);
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec!["export", "no/such.json", "--engine", "lammps"],
+            "no/such.json: cannot read",
+        ),
+        (
+            vec!["export", &garbled, "--engine", "lammps"],
+            "garbled.json:3: not valid JSON",
+        ),
+        (
+            vec!["export", &wrong, "--engine", "lammps"],
+            "'material.youngs_pa' is \"hard\"",
+        ),
+        (
+            vec!["export", params, "--engine", "lammps", "--model", "vmm"],
+            "unknown model 'vmm'",
+        ),
+        (
+            vec!["export", params, "--engine", "lammps", "--model", "pm"],
+            "model pm has no exact engine form",
+        ),
+        (
+            vec![
+                "export",
+                &bound,
+                "--engine",
+                "lammps",
+                "--model",
+                "min",
+                "--v-range",
+                "1,2",
+            ],
+            "sigma_y' has no value",
+        ),
+        (
+            vec!["export", params, "--engine", "constant-e"],
+            "--v-range",
+        ),
+        (
+            vec![
+                "export",
+                params,
+                "--engine",
+                "constant-e",
+                "--v-range",
+                "2,1",
+            ],
+            "--v-range",
+        ),
+        (
+            vec![
+                "export",
+                params,
+                "--engine",
+                "constant-e",
+                "--v-range",
+                "0,1",
+            ],
+            "lower end > 0",
+        ),
+        (
+            vec!["export", params, "--engine", "constant-e", "--v-range", "1"],
+            "not LO,HI",
+        ),
+        (
+            vec![
+                "export",
+                params,
+                "--engine",
+                "constant-e",
+                "--v-range",
+                "a,2",
+            ],
+            "'a' is not a number",
+        ),
+        (
+            vec![
+                "export",
+                params,
+                "--engine",
+                "constant-e",
+                "--v-range",
+                "1,1e300",
+            ],
+            "at most 1e6 m/s",
+        ),
+        (
+            vec![
+                "export",
+                params,
+                "--engine",
+                "constant-e",
+                "--v-range",
+                "1,2",
+                "--tolerance",
+                "0",
+            ],
+            "--tolerance 0",
+        ),
+        (
+            vec![
+                "export",
+                params,
+                "--engine",
+                "constant-e",
+                "--v-range",
+                "1,2",
+                "--tolerance=-1e-3",
+            ],
+            "--tolerance -0.001",
+        ),
+        (
+            vec![
+                "export",
+                params,
+                "--engine",
+                "constant-e",
+                "--v-range",
+                "1,2",
+                "--tolerance",
+                "nan",
+            ],
+            "--tolerance NaN",
+        ),
+        (
+            vec![
+                "export",
+                params,
+                "--engine",
+                "lammps",
+                "--tolerance",
+                "0.01",
+            ],
+            "--tolerance needs --v-range",
+        ),
+        (
+            vec![
+                "export",
+                params,
+                "--engine",
+                "table",
+                "--v-range",
+                "1,2",
+                "--verify",
+            ],
+            "--verify checks LAMMPS files",
+        ),
+        (
+            vec!["export", params, "--engine", "lammps", "--eta", "190"],
+            "--eta comes from",
+        ),
+        (
+            vec![
+                "export",
+                params,
+                "--engine",
+                "lammps",
+                "--model",
+                "vm",
+                "--d-mm",
+                "6.35,6.35",
+            ],
+            "given twice",
+        ),
+        (
+            vec![
+                "export",
+                params,
+                "--engine",
+                "lammps",
+                "--model",
+                "vm",
+                "--d-mm=-1",
+            ],
+            "--d-mm -1",
+        ),
+        (
+            vec![
+                "export",
+                params,
+                "--engine",
+                "table",
+                "--v-range",
+                "1,2",
+                "--table-points",
+                "1",
+            ],
+            "--table-points 1",
+        ),
+        (
+            vec![
+                "export",
+                params,
+                "--engine",
+                "lammps",
+                "--model",
+                "vm",
+                "--walton",
+                "no/w.json",
+            ],
+            "no/w.json: cannot read",
+        ),
+        (
+            vec![
+                "export",
+                "--engine",
+                "lammps",
+                "--material",
+                "nylon",
+                "--d-mm",
+                "5",
+            ],
+            "give PARAMS.json",
+        ),
+        (
+            vec![
+                "export",
+                "--engine",
+                "lammps",
+                "--material",
+                "nylon",
+                "--d-mm",
+                "5",
+                "--eta",
+                "1e400",
+            ],
+            "--eta",
+        ),
+        (
+            vec![
+                "export",
+                "--engine",
+                "lammps",
+                "--material",
+                "nylon",
+                "--eta",
+                "190",
+            ],
+            "--d-mm",
+        ),
+        (
+            vec![
+                "export",
+                "--engine",
+                "lammps",
+                "--material",
+                "nylon",
+                "--d-mm",
+                "5",
+                "--eta",
+                "190",
+                "--mu0=-1",
+            ],
+            "--mu0 -1",
+        ),
+        (
+            vec![
+                "export",
+                "--engine",
+                "lammps",
+                "--material",
+                "nylon",
+                "--d-mm",
+                "5",
+                "--eta",
+                "190",
+                "--speeds",
+                "0",
+            ],
+            "--speeds 0",
+        ),
+    ];
+    for (args, want) in cases {
+        refuses(&args, want);
+    }
+}
+
+#[test]
+fn powerlaw_beyond_its_range_is_an_error_not_a_number() {
+    // 1 - e = A (d/10 mm)^(-a) v^b reaches e < 0 at high speed: the export must say so.
+    refuses(
+        &[
+            "export",
+            "reports/fit/params.json",
+            "--engine",
+            "table",
+            "--model",
+            "powerlaw",
+            "--v-range",
+            "0.5,1e5",
+        ],
+        "fitted e at speed",
+    );
+}
