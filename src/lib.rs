@@ -7,6 +7,7 @@ pub mod data;
 pub mod error;
 pub mod experiment;
 pub mod fit;
+pub mod frames;
 pub mod kinematics;
 pub mod models;
 pub mod plot;
