@@ -36,3 +36,7 @@ impl GrayImage {
         self.pixels[row * self.width + col] = value;
     }
 }
+
+pub mod circle;
+pub mod edges;
+pub mod segment;
