@@ -40,3 +40,6 @@ impl GrayImage {
 pub mod circle;
 pub mod edges;
 pub mod segment;
+pub mod markers;
+pub mod detect;
+pub mod spin;
