@@ -38,8 +38,9 @@ impl GrayImage {
 }
 
 pub mod circle;
-pub mod edges;
-pub mod segment;
-pub mod markers;
 pub mod detect;
+pub mod edges;
+pub mod markers;
+pub mod segment;
 pub mod spin;
+pub mod track;
