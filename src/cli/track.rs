@@ -35,13 +35,19 @@ pub struct Args {
     #[arg(value_name = "DIR", required = true)]
     dirs: Vec<PathBuf>,
     /// Frame rate, frames per second
-    #[arg(long, value_name = "F")]
+    #[arg(long, value_name = "F", allow_negative_numbers = true)]
     fps: f64,
     /// Pixel size in the object plane, m
-    #[arg(long = "pixel-m", value_name = "P", required_unless_present = "d_mm")]
+    #[arg(long = "pixel-m", value_name = "P", allow_negative_numbers = true)]
     pixel_m: Option<f64>,
     /// Sphere diameters, mm (one value: both spheres)
-    #[arg(long = "d-mm", value_name = "D1[,D2]", value_delimiter = ',', num_args = 1..=2)]
+    #[arg(
+        long = "d-mm",
+        value_name = "D1[,D2]",
+        value_delimiter = ',',
+        num_args = 1..=2,
+        allow_negative_numbers = true
+    )]
     d_mm: Option<Vec<f64>>,
     /// Write tracks.csv, detections.csv, spins.csv, collisions.csv and overlays here
     #[arg(long, value_name = "OUT")]
@@ -73,6 +79,11 @@ pub fn run(args: Args) -> CliResult {
         ]),
         Some(_) => return Err("--d-mm takes one or two diameters".into()),
     };
+    if pixel_m.is_none() && d_m.is_none() {
+        return Err(
+            "the scale is missing: give --pixel-m P (pixel size in the object plane, m) or --d-mm D1[,D2] (the diameters set it)".into(),
+        );
+    }
     let mut detect = DetectSettings::default();
     if let (Some(d), Some(p)) = (d_m, pixel_m) {
         detect.known_radii_px = vec![d[0] / p / 2.0, d[1] / p / 2.0];

@@ -67,11 +67,29 @@ pub fn overlay_svg(
         let used = RGBColor(0, 200, 80);
         let rejected = RGBColor(230, 40, 40);
         let marker = RGBColor(255, 190, 0);
-        let mut first = [true; 4];
-        let mut label = |i: usize| std::mem::replace(&mut first[i], false);
         for (s, obs) in frame.spheres.iter().enumerate() {
             let Some(o) = obs else { continue };
-            let c = super::colour(s);
+            let (inl, outl): (Vec<_>, Vec<_>) =
+                o.edges.iter().zip(&o.inliers).partition(|(_, used)| **used);
+            chart
+                .draw_series(
+                    inl.iter()
+                        .map(|(p, _)| Circle::new((p[0], p[1]), 1, used.filled())),
+                )
+                .map_err(e)?;
+            chart
+                .draw_series(
+                    outl.iter()
+                        .map(|(p, _)| Cross::new((p[0], p[1]), 3, rejected.stroke_width(1))),
+                )
+                .map_err(e)?;
+            chart
+                .draw_series(
+                    o.markers
+                        .iter()
+                        .map(|m| Circle::new((m[0], m[1]), 5, marker.stroke_width(2))),
+                )
+                .map_err(e)?;
             let circle: Vec<(f64, f64)> = (0..=180)
                 .map(|i| {
                     let a = std::f64::consts::TAU * i as f64 / 180.0;
@@ -79,84 +97,82 @@ pub fn overlay_svg(
                 })
                 .collect();
             chart
-                .draw_series(LineSeries::new(circle, c.stroke_width(2)))
-                .map_err(e)?
-                .label(format!(
-                    "sphere {}: r = {:.2} px ({})",
-                    s + 1,
-                    o.r_px,
-                    o.radius_mode.name()
-                ))
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2))
-                });
-            let (inl, outl): (Vec<_>, Vec<_>) =
-                o.edges.iter().zip(&o.inliers).partition(|(_, used)| **used);
-            let s_used = chart
-                .draw_series(
-                    inl.iter()
-                        .map(|(p, _)| Circle::new((p[0], p[1]), 2, used.filled())),
-                )
+                .draw_series(LineSeries::new(circle, super::colour(s).stroke_width(2)))
                 .map_err(e)?;
-            if label(0) {
-                s_used
-                    .label("edge points used")
-                    .legend(move |(x, y)| Circle::new((x + 9, y), 3, used.filled()));
-            }
-            let s_rej = chart
-                .draw_series(
-                    outl.iter()
-                        .map(|(p, _)| Cross::new((p[0], p[1]), 3, rejected.stroke_width(1))),
-                )
-                .map_err(e)?;
-            if !outl.is_empty() && label(1) {
-                s_rej
-                    .label("edge points rejected")
-                    .legend(move |(x, y)| Cross::new((x + 9, y), 4, rejected.stroke_width(1)));
-            }
-            let s_m = chart
-                .draw_series(
-                    o.markers
-                        .iter()
-                        .map(|m| Circle::new((m[0], m[1]), 5, marker.stroke_width(2))),
-                )
-                .map_err(e)?;
-            if !o.markers.is_empty() && label(2) {
-                s_m.label("markers")
-                    .legend(move |(x, y)| Circle::new((x + 9, y), 5, marker.stroke_width(2)));
-            }
-            // A star at the centre: three crossing strokes.
+            // A star at the centre: black strokes under white ones, visible on any sphere.
             let arm = 9.0 / k;
-            let star: Vec<PathElement<(f64, f64)>> = (0..3)
-                .map(|i| {
-                    let a = std::f64::consts::PI * (0.5 + i as f64 / 3.0);
-                    PathElement::new(
-                        vec![
-                            (o.x_px - arm * a.cos(), o.y_px - arm * a.sin()),
-                            (o.x_px + arm * a.cos(), o.y_px + arm * a.sin()),
-                        ],
-                        WHITE.stroke_width(2),
-                    )
+            let star: Vec<PathElement<(f64, f64)>> = [(BLACK, 4), (WHITE, 2)]
+                .iter()
+                .flat_map(|&(colour, width)| {
+                    (0..3).map(move |i| {
+                        let a = std::f64::consts::PI * (0.5 + i as f64 / 3.0);
+                        PathElement::new(
+                            vec![
+                                (o.x_px - arm * a.cos(), o.y_px - arm * a.sin()),
+                                (o.x_px + arm * a.cos(), o.y_px + arm * a.sin()),
+                            ],
+                            colour.stroke_width(width),
+                        )
+                    })
                 })
                 .collect();
-            let s_c = chart.draw_series(star).map_err(e)?;
-            if label(3) {
-                s_c.label("centres").legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y - 6), (x + 12, y + 6)], BLACK.stroke_width(2))
-                });
-            }
+            chart.draw_series(star).map_err(e)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::Coordinate(
-                area.0.end + 10,
-                area.1.start,
-            ))
-            .label_font(("sans-serif", 15))
-            .background_style(WHITE.mix(0.9))
-            .border_style(BLACK.mix(0.5))
-            .draw()
-            .map_err(e)?;
+        // The legend, drawn by hand to the right of the frame (plotters places series labels
+        // inside the plotting area, over the image).
+        let x0 = area.0.end + 20;
+        let mut y = area.1.start + 10;
+        let font = ("sans-serif", 15).into_font();
+        let mut entry = |text: String, glyph: &dyn Fn(i32, i32) -> Result<(), String>| {
+            glyph(x0 + 8, y)?;
+            root.draw(&Text::new(text, (x0 + 24, y - 7), font.clone()))
+                .map_err(e)?;
+            y += 24;
+            Ok::<(), String>(())
+        };
+        for (s, obs) in frame.spheres.iter().enumerate() {
+            let Some(o) = obs else { continue };
+            let c = super::colour(s);
+            entry(
+                format!("sphere {}: r = {:.2} px", s + 1, o.r_px),
+                &|x, y| {
+                    root.draw(&PathElement::new(
+                        vec![(x - 8, y), (x + 8, y)],
+                        c.stroke_width(2),
+                    ))
+                    .map_err(e)
+                },
+            )?;
+            entry(
+                format!("  {} edge points, {}", o.n_edge, o.radius_mode.name()),
+                &|_, _| Ok(()),
+            )?;
+        }
+        entry("edge points used".into(), &|x, y| {
+            root.draw(&Circle::new((x, y), 3, used.filled())).map_err(e)
+        })?;
+        entry("edge points rejected".into(), &|x, y| {
+            root.draw(&Cross::new((x, y), 4, rejected.stroke_width(1)))
+                .map_err(e)
+        })?;
+        entry("markers".into(), &|x, y| {
+            root.draw(&Circle::new((x, y), 5, marker.stroke_width(2)))
+                .map_err(e)
+        })?;
+        entry("centres".into(), &|x, y| {
+            for (colour, width) in [(BLACK, 4), (WHITE, 2)] {
+                for i in 0..3 {
+                    let a = std::f64::consts::PI * (0.5 + i as f64 / 3.0);
+                    let (dx, dy) = ((8.0 * a.cos()) as i32, (8.0 * a.sin()) as i32);
+                    root.draw(&PathElement::new(
+                        vec![(x - dx, y - dy), (x + dx, y + dy)],
+                        colour.stroke_width(width),
+                    ))
+                    .map_err(e)?;
+                }
+            }
+            Ok(())
+        })?;
         root.present().map_err(e)?;
     }
     // The frame goes right after the background rectangle, under everything else.
