@@ -8,6 +8,7 @@ pub mod dem;
 pub mod error;
 pub mod experiment;
 pub mod fit;
+pub mod frames;
 pub mod kinematics;
 pub mod models;
 pub mod plot;

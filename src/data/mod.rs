@@ -11,6 +11,8 @@
 //! [`write_all_atomic`].
 
 pub mod export;
+pub mod frames;
+pub mod images;
 mod table;
 pub mod tracks;
 pub mod walton;

@@ -39,7 +39,7 @@
 //! trajectory gives 1 - e = alpha J_0 with J_0 = 2 int_0^x_max x^q p dx, which is
 //! 0.8 sqrt(5/4) B(1/2, 3/2) = pi/sqrt(5) for q = 1/4 and C1 = 1.1534488580952888 for q = 1/2.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, IntegrationFailure, Result};
 use crate::models::viscoelastic::ContactEnd;
 
 /// The exponent q of the dashpot alpha x^q x'.
@@ -118,10 +118,11 @@ fn finite(y: &Y) -> bool {
     y.iter().all(|v| v.is_finite())
 }
 
-fn fail(alpha: f64, reason: impl Into<String>) -> Error {
+fn fail(alpha: f64, kind: IntegrationFailure, reason: impl Into<String>) -> Error {
     Error::Integration {
         method: "rk4 (damped Hertz)",
         kappa: alpha,
+        kind,
         reason: reason.into(),
     }
 }
@@ -194,13 +195,13 @@ pub fn rebound(
     loop {
         count += 1;
         if count > 4 * n + 200 {
-            return Err(fail(alpha, "loading phase did not slow down as it must"));
+            return Err(fail(alpha, IntegrationFailure::PhaseIncomplete, "loading phase did not slow down as it must"));
         }
         let trial = rk4(&f_s, s, &y, h);
         if !finite(&trial) || trial[0] < 0.25 {
             h *= 0.5;
             if h < 1e-300 {
-                return Err(fail(alpha, "loading step size underflow"));
+                return Err(fail(alpha, IntegrationFailure::StepSizeUnderflow, "loading step size underflow"));
             }
             continue;
         }
@@ -222,7 +223,7 @@ pub fn rebound(
         k += 1;
         if k > max_t_steps {
             return Err(fail(
-                alpha,
+                alpha, IntegrationFailure::PhaseIncomplete,
                 format!(
                     "no rebound within t = {} (dimensionless)",
                     h_t * max_t_steps as f64
@@ -231,7 +232,7 @@ pub fn rebound(
         }
         let next = rk4(&f_t, t, &yt, h_t);
         if !finite(&next) {
-            return Err(fail(alpha, format!("non-finite state at t = {t}")));
+            return Err(fail(alpha, IntegrationFailure::NonFinite, format!("non-finite state at t = {t}")));
         }
         if rule == ContactEnd::Force && next[1] < 0.0 && g_t(&next) <= 0.0 {
             let (theta, y_end) = locate(|th| rk4(&f_t, t, &yt, th * h_t), |_, yy| g_t(yy));
@@ -257,7 +258,7 @@ pub fn rebound(
                 let next = rk4(&f_s, s, &y, h_c);
                 if !finite(&next) || next[0] >= 0.0 {
                     return Err(fail(
-                        alpha,
+                        alpha, IntegrationFailure::Unphysical,
                         format!("unphysical unloading state at s = {s}: p = {}", next[0]),
                     ));
                 }
@@ -290,7 +291,7 @@ pub fn rebound(
     if !(e.is_finite() && e > 0.0 && e <= 1.0 + 1e-12) || (e * e - e_energy * e_energy).abs() > 1e-6
     {
         return Err(fail(
-            alpha,
+            alpha, IntegrationFailure::Unphysical,
             format!("unphysical result: e = {e} from the speed, {e_energy} from the energy"),
         ));
     }
@@ -365,7 +366,7 @@ pub fn alpha_for_e(e: f64, dashpot: Dashpot, rule: ContactEnd) -> Result<f64> {
     }
     if !found {
         return Err(fail(
-            f64::NAN,
+            f64::NAN, IntegrationFailure::Other,
             format!("could not bracket alpha for e = {e}"),
         ));
     }
@@ -376,7 +377,7 @@ pub fn alpha_for_e(e: f64, dashpot: Dashpot, rule: ContactEnd) -> Result<f64> {
         let mid = (lo * hi).sqrt();
         let f = one_minus(mid)?;
         if f.is_nan() {
-            return Err(fail(mid, "e(alpha) is NaN"));
+            return Err(fail(mid, IntegrationFailure::NonFinite, "e(alpha) is NaN"));
         }
         if f > 0.0 {
             lo = mid;
@@ -384,5 +385,5 @@ pub fn alpha_for_e(e: f64, dashpot: Dashpot, rule: ContactEnd) -> Result<f64> {
             hi = mid;
         }
     }
-    Err(fail(lo, format!("bisection for e = {e} did not converge")))
+    Err(fail(lo, IntegrationFailure::Other, format!("bisection for e = {e} did not converge")))
 }

@@ -5,7 +5,7 @@
 use super::range::{SpeedRange, Weight, max_abs, max_of, mean, nodes};
 use crate::contact::Contact;
 use crate::error::{Error, Result};
-use crate::fit::lsq::brent_minimize;
+use crate::fit::scalar::brent_minimize;
 use crate::fit::models::{ModelKind, e_vm, predict_e};
 use crate::models::viscoelastic::master::KAPPA_MAX;
 use crate::models::viscoelastic::{ContactEnd, VmMethod};
@@ -288,9 +288,9 @@ pub fn viscoelastic_fit(
         }
         let lo = grid[best.0.saturating_sub(1)];
         let hi = grid[(best.0 + 1).min(ETA_SCAN - 1)];
-        let (x, y, ok) = brent_minimize(f, lo, hi, 1e-12)?;
-        converged &= ok;
-        Ok(if y <= best.1 { x } else { grid[best.0] })
+        let m = brent_minimize(f, lo, hi, 1e-12)?;
+        converged &= m.converged;
+        Ok(if m.fx <= best.1 { m.x } else { grid[best.0] })
     };
     let eta_mean = minimise(&ls)?.exp();
     let eta_minimax = minimise(&mm)?.exp();
