@@ -1,5 +1,6 @@
 //! The I/O layer: CSV input with exact line numbers, validated numbers, CSV output through
-//! `csv::Writer`, atomic output files, and the file schemas (tracks, oblique collisions).
+//! `csv::Writer`, atomic output files, and the file schemas (fit data, tracks, oblique
+//! collisions).
 //!
 //! Every input schema of the toolkit (fit data, oblique collisions, tracks) is read through
 //! [`Table`]: a header line, then rows; lines starting with `#` and blank lines are skipped but
@@ -11,6 +12,7 @@
 //! [`write_all_atomic`].
 
 pub mod export;
+pub mod fit_input;
 pub mod frames;
 pub mod images;
 mod table;

@@ -1,0 +1,245 @@
+//! The input schema of `restitution fit`: a CSV of measured e against normal impact speed.
+//!
+//! Columns, in any order (others are ignored): `d_mm` (required), `v_n_m_s` (required), `e`
+//! (required), `e_err` (optional, absolute one-sigma error of e), `v_err_m_s` (optional, the
+//! speed error Delta v; used as sigma_e = 2 e Delta v / v_n, the paper's error model below Fig. 7,
+//! when `e_err` is absent), `d2_mm` (optional second diameter; `inf` for a flat wall; absent
+//! means identical spheres). Lines starting with `#` and blank lines are skipped; errors name the
+//! file, line, column and value ([`Table`] counts the lines itself).
+//!
+//! Suspicious values are warnings, one line per kind with the first occurrence and a count:
+//! e > 1 (possible within the errors of a real measurement, so such rows are kept) and a
+//! diameter below 0.1 mm (probably metres). `strict` turns them into errors.
+
+use super::{DataError, Table};
+use crate::contact::Material;
+use crate::fit::dataset::{FitData, Observation};
+use std::path::Path;
+
+/// Where the errors of e came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ErrorSource {
+    /// The `e_err` column.
+    EErr,
+    /// The `v_err_m_s` column through sigma_e = 2 e v_err / v_n.
+    VErr,
+    /// No error columns: an unweighted fit.
+    None,
+}
+
+impl ErrorSource {
+    pub fn describe(self) -> &'static str {
+        match self {
+            ErrorSource::EErr => "e_err",
+            ErrorSource::VErr => "v_err_m_s (sigma_e = 2 e v_err / v_n)",
+            ErrorSource::None => "none (unweighted fit)",
+        }
+    }
+}
+
+/// A parsed fit input.
+#[derive(Debug, Clone)]
+pub struct FitInput {
+    pub path: String,
+    pub data: FitData,
+    /// The line of each observation in the file.
+    pub lines: Vec<usize>,
+    pub error_source: ErrorSource,
+    /// Suspicious values, one per kind (first occurrence; the message counts the others).
+    pub warnings: Vec<DataError>,
+}
+
+/// Reads and validates a fit input file.
+pub fn read_fit_csv(path: &Path, material: Material, strict: bool) -> Result<FitInput, DataError> {
+    let table = Table::read(path)?;
+    from_table(&table, material, strict)
+}
+
+/// As [`read_fit_csv`], from text in memory (`name` is used in messages).
+pub fn parse_fit_csv(
+    name: &str,
+    text: &str,
+    material: Material,
+    strict: bool,
+) -> Result<FitInput, DataError> {
+    let table = Table::parse(name, text)?;
+    from_table(&table, material, strict)
+}
+
+/// A suspicious value seen in some rows: the first one and how many.
+struct Suspicion {
+    first: Option<DataError>,
+    count: usize,
+}
+
+impl Suspicion {
+    fn new() -> Self {
+        Suspicion {
+            first: None,
+            count: 0,
+        }
+    }
+    fn note(&mut self, err: DataError) {
+        self.count += 1;
+        if self.first.is_none() {
+            self.first = Some(err);
+        }
+    }
+    fn finish(self) -> Option<DataError> {
+        self.first.map(|mut e| {
+            if self.count > 1 {
+                e.message += &format!(" (and {} more rows like it)", self.count - 1);
+            }
+            e
+        })
+    }
+}
+
+fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInput, DataError> {
+    let c_d = table.require("d_mm")?;
+    let c_v = table.require("v_n_m_s")?;
+    let c_e = table.require("e")?;
+    let c_eerr = table.column("e_err");
+    let c_verr = table.column("v_err_m_s");
+    let c_d2 = table.column("d2_mm");
+    let error_source = match (c_eerr, c_verr) {
+        (Some(_), _) => ErrorSource::EErr,
+        (None, Some(_)) => ErrorSource::VErr,
+        (None, None) => ErrorSource::None,
+    };
+    let mut above_one = Suspicion::new();
+    let mut tiny = Suspicion::new();
+    let mut obs = Vec::with_capacity(table.rows.len());
+    let mut lines = Vec::with_capacity(table.rows.len());
+    let strict_or = |s: &mut Suspicion, err: DataError| -> Result<(), DataError> {
+        if strict {
+            let mut err = err;
+            err.message += " (an error with --strict)";
+            Err(err)
+        } else {
+            s.note(err);
+            Ok(())
+        }
+    };
+    for row in &table.rows {
+        let d_mm = table.number_where(row, c_d, |x| x > 0.0, "a diameter > 0 (mm)")?;
+        if d_mm < 0.1 {
+            let msg = format!(
+                "'{}' is below 0.1 mm: is the diameter in metres? (d_mm is millimetres)",
+                table.shown(row, c_d)
+            );
+            strict_or(&mut tiny, table.cell_error(row, c_d, msg))?;
+        }
+        let d2_mm = match c_d2 {
+            Some(c) => {
+                let d2 = table.positive_or_inf(row, c)?;
+                if d2 < 0.1 {
+                    let msg = format!(
+                        "'{}' is below 0.1 mm: is the diameter in metres? (d2_mm is millimetres)",
+                        table.shown(row, c)
+                    );
+                    strict_or(&mut tiny, table.cell_error(row, c, msg))?;
+                }
+                Some(d2)
+            }
+            None => None,
+        };
+        let v = table.number_where(row, c_v, |x| x > 0.0, "a speed > 0 (m/s)")?;
+        let e = table.number_where(row, c_e, |x| x >= 0.0, "e >= 0")?;
+        if e > 1.0 {
+            let msg = format!(
+                "'{}' is above 1 (kept: possible within the errors of a measurement)",
+                table.shown(row, c_e)
+            );
+            strict_or(&mut above_one, table.cell_error(row, c_e, msg))?;
+        }
+        let e_err = match (c_eerr, c_verr) {
+            (Some(c), _) => Some(table.number_where(row, c, |x| x > 0.0, "an error > 0")?),
+            (None, Some(c)) => {
+                let dv = table.number_where(row, c, |x| x > 0.0, "a speed error > 0 (m/s)")?;
+                let s = 2.0 * e * dv / v;
+                if !(s > 0.0 && s.is_finite()) {
+                    return Err(table.cell_error(
+                        row,
+                        c_e,
+                        format!(
+                            "'{}' gives sigma_e = 2 e v_err / v_n = {s}: give an e_err column",
+                            table.shown(row, c_e)
+                        ),
+                    ));
+                }
+                Some(s)
+            }
+            (None, None) => None,
+        };
+        obs.push(Observation {
+            d_mm,
+            d2_mm,
+            v_n_m_s: v,
+            e,
+            e_err,
+        });
+        lines.push(row.line);
+    }
+    let data = FitData::new(material, obs).map_err(|e| DataError {
+        path: table.path.clone(),
+        line: None,
+        column: None,
+        message: e.to_string(),
+    })?;
+    let warnings = [tiny.finish(), above_one.finish()]
+        .into_iter()
+        .flatten()
+        .collect();
+    Ok(FitInput {
+        path: table.path.clone(),
+        data,
+        lines,
+        error_source,
+        warnings,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn nylon() -> Material {
+        Material::preset("nylon").unwrap()
+    }
+
+    #[test]
+    fn columns_in_any_order_and_the_papers_error_model() {
+        let text =
+            "# c\nextra,e,v_n_m_s,v_err_m_s,d_mm\nx,0.9,2.0,0.04,12.7\n\ny,1.02,1.0,0.04,6.35\n";
+        let inp = parse_fit_csv("f.csv", text, nylon(), false).unwrap();
+        assert_eq!(inp.lines, vec![3, 5]);
+        assert_eq!(inp.error_source, ErrorSource::VErr);
+        // sigma_e = 2 e Delta v / v_n.
+        assert!((inp.data.obs[0].e_err.unwrap() - 2.0 * 0.9 * 0.04 / 2.0).abs() < 1e-15);
+        assert_eq!(inp.warnings.len(), 1);
+        assert_eq!(
+            inp.warnings[0].to_string(),
+            "f.csv:5: column 'e': '1.02' is above 1 (kept: possible within the errors of a measurement)"
+        );
+        let err = parse_fit_csv("f.csv", text, nylon(), true).unwrap_err();
+        assert_eq!(err.line, Some(5));
+        assert!(err.to_string().contains("--strict"), "{err}");
+    }
+
+    #[test]
+    fn wall_and_unweighted() {
+        let text =
+            "d_mm,d2_mm,v_n_m_s,e\n12.7,inf,1.0,0.95\n12.7,25.4,1.0,0.95\n0.0127,inf,1,0.9\n";
+        let inp = parse_fit_csv("w.csv", text, nylon(), false).unwrap();
+        assert_eq!(inp.error_source, ErrorSource::None);
+        assert!(!inp.data.weighted);
+        assert_eq!(inp.data.obs[0].d2_mm, Some(f64::INFINITY));
+        assert_eq!(inp.warnings.len(), 1);
+        assert!(
+            inp.warnings[0]
+                .to_string()
+                .starts_with("w.csv:4: column 'd_mm'")
+        );
+    }
+}
