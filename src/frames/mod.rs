@@ -36,3 +36,4 @@ impl GrayImage {
         self.pixels[row * self.width + col] = value;
     }
 }
+pub mod render;
