@@ -36,4 +36,11 @@ impl GrayImage {
         self.pixels[row * self.width + col] = value;
     }
 }
+
+pub mod circle;
+pub mod edges;
+pub mod segment;
+pub mod markers;
+pub mod detect;
+pub mod spin;
 pub mod render;
