@@ -27,9 +27,10 @@ use restitution::frames::GrayImage;
 use restitution::frames::render::{
     FilmSpec, Lighting, Renderer, Sensor, SpherePose, View, expose, film_collision, marker_pattern,
 };
+use restitution::frames::spin::{MarkerFrame, lift, phase_spin};
 use restitution::kinematics::{FitKind, Frame, measure_e};
 use restitution::models::viscoelastic::{ContactEnd, VmMethod};
-use restitution::plot::frames::{Line, Panel, accuracy_svg};
+use restitution::plot::frames_accuracy::{Line, Panel, accuracy_svg};
 use std::path::PathBuf;
 
 const CAMERA: Camera = Camera::PAPER;
@@ -39,19 +40,29 @@ const PER_CONDITION: usize = 60;
 const PER_SPEED: usize = 40;
 const SUBPIXELS_PER_PIXEL: f64 = 4.0;
 
-/// A centre-finding method: the centres (col, row pixels) of the spheres near `hints` (rough
-/// positions, used only to say which found sphere is which), or None where it found none.
-pub type Method = fn(&GrayImage, &[[f64; 2]], &[f64]) -> Vec<Option<[f64; 2]>>;
+/// What a method found of one sphere: centre and radius (pixels; col right, row down from the
+/// top-left corner, pixel centres at +0.5) and marker positions (same coordinates).
+#[derive(Debug, Clone)]
+pub struct Found {
+    pub centre: [f64; 2],
+    pub radius: f64,
+    pub markers: Vec<[f64; 2]>,
+}
+
+/// A centre-finding method: the spheres near `hints` (rough positions, used only to say which
+/// found sphere is which; `radii` are the known radii), or None where it found none.
+pub type Method = fn(&GrayImage, &[[f64; 2]], &[f64]) -> Vec<Option<Found>>;
 
 fn methods() -> Vec<(&'static str, Method)> {
-    let mut m: Vec<(&'static str, Method)> = vec![("naive blob centroid", naive_centres)];
-    m.extend(detector::methods());
-    m
+    vec![
+        ("naive blob centroid", naive_centres),
+        ("detector (src/frames)", detector::detector),
+    ]
 }
 
 /// The naive baseline: for each hint, the centroid of the blob nearest to it (within half the
 /// radius, else none).
-fn naive_centres(img: &GrayImage, hints: &[[f64; 2]], radii: &[f64]) -> Vec<Option<[f64; 2]>> {
+fn naive_centres(img: &GrayImage, hints: &[[f64; 2]], radii: &[f64]) -> Vec<Option<Found>> {
     let blobs = naive::blobs(img);
     hints
         .iter()
@@ -62,7 +73,11 @@ fn naive_centres(img: &GrayImage, hints: &[[f64; 2]], radii: &[f64]) -> Vec<Opti
                 .map(|b| ((b.col - h[0]).hypot(b.row - h[1]), b))
                 .filter(|(d, _)| *d < 0.5 * r)
                 .min_by(|a, b| a.0.total_cmp(&b.0))
-                .map(|(_, b)| [b.col, b.row])
+                .map(|(_, b)| Found {
+                    centre: [b.col, b.row],
+                    radius: (b.area as f64 / std::f64::consts::PI).sqrt(),
+                    markers: Vec::new(),
+                })
         })
         .collect()
 }
@@ -235,8 +250,8 @@ fn centre_study(rng: &mut StdRng) -> Vec<CentreRow> {
         for _ in 0..PER_CONDITION {
             let (img, truth) = single_frame(&cond, rng);
             for (k, (_, m)) in ms.iter().enumerate() {
-                match m(&img, &[truth], &[cond.radius_px])[0] {
-                    Some(c) => errs[k].push([c[0] - truth[0], c[1] - truth[1]]),
+                match &m(&img, &[truth], &[cond.radius_px])[0] {
+                    Some(f) => errs[k].push([f.centre[0] - truth[0], f.centre[1] - truth[1]]),
                     None => failed[k] += 1,
                 }
             }
@@ -261,10 +276,19 @@ struct ERow {
     measured: usize,
     rms_rel: f64,
     median_abs_rel: f64,
+    /// Spins (w_z, per sphere and phase) measured, and their rms error, rad/s.
+    spins: usize,
+    spin_rms_rad_s: f64,
 }
 
-/// e through the chain at each speed: truth centres plus the paper's s = 2 subpixels of Gaussian
-/// noise, and each method's centres, on the same frames.
+/// Matching tolerance of markers between frames, radians (as in the spin module's tests; a
+/// spin of 3 rad/s turns a marker by 0.003 rad per frame).
+const SPIN_TOL_RAD: f64 = 0.05;
+/// Markers beyond this fraction of the radius are not lifted (z ill-determined near the limb).
+const LIFT_MAX_FRAC: f64 = 0.9;
+
+/// e (and the spins) through the chain at each speed: truth centres plus the paper's s = 2
+/// subpixels of Gaussian noise, and each method's centres, on the same frames.
 fn e_study(rng: &mut StdRng) -> Vec<ERow> {
     let material = restitution::contact::Material::preset("nylon").expect("preset");
     let d = 0.0127;
@@ -281,7 +305,7 @@ fn e_study(rng: &mut StdRng) -> Vec<ERow> {
         )
     };
     let p = CAMERA.pixel_m();
-    let h_m = CAMERA.pixels_y as f64 * p;
+    let h_px = CAMERA.pixels_y as f64;
     let ms = methods();
     let mut rows = Vec::new();
     for exposure in [0.0, 2.5e-4] {
@@ -312,12 +336,20 @@ fn e_study(rng: &mut StdRng) -> Vec<ERow> {
                 .chain(ms.iter().map(|(n, _)| n.to_string()))
                 .collect();
             let mut rel: Vec<Vec<f64>> = vec![Vec::new(); labels.len()];
+            let mut spin_err: Vec<Vec<f64>> = vec![Vec::new(); labels.len()];
             let sigma_px = 2.0 / SUBPIXELS_PER_PIXEL;
             for sim in &sims {
                 let f = film_collision(sim, &film, rng).expect("films");
                 let mut tracks: Vec<(Vec<Frame>, usize)> = vec![(Vec::new(), 0); labels.len()];
+                // Marker frames per method, sphere and phase.
+                let mut marks: Vec<[[Vec<MarkerFrame>; 2]; 2]> =
+                    (0..labels.len()).map(|_| Default::default()).collect();
+                let mut true_wz = [[f64::NAN; 2]; 2];
                 for (img, t) in f.frames.iter().zip(&f.truth) {
                     let [a, b] = t.spheres;
+                    let phase = usize::from(t.post);
+                    true_wz[0][phase] = a.spin_rad_s[2];
+                    true_wz[1][phase] = b.spin_rad_s[2];
                     let gap = (a.col_px - b.col_px).hypot(a.row_px - b.row_px)
                         - a.radius_px
                         - b.radius_px;
@@ -326,31 +358,41 @@ fn e_study(rng: &mut StdRng) -> Vec<ERow> {
                         continue;
                     }
                     let truth = [[a.col_px, a.row_px], [b.col_px, b.row_px]];
-                    let mut found: Vec<Option<[[f64; 2]; 2]>> = Vec::new();
-                    let noisy = truth.map(|c| {
-                        c.map(|x| {
+                    let mut found: Vec<Option<[Found; 2]>> = Vec::new();
+                    let noisy = truth.map(|c| Found {
+                        centre: c.map(|x| {
                             let z: f64 = StandardNormal.sample(rng);
                             x + sigma_px * z
-                        })
+                        }),
+                        radius: a.radius_px,
+                        markers: Vec::new(),
                     });
                     found.push(Some(noisy));
                     for (_, m) in &ms {
-                        let c = m(img, &truth, &[a.radius_px, b.radius_px]);
-                        found.push(match (c[0], c[1]) {
+                        let mut c = m(img, &truth, &[a.radius_px, b.radius_px]);
+                        found.push(match (c[0].take(), c[1].take()) {
                             (Some(x), Some(y)) => Some([x, y]),
                             _ => None,
                         });
                     }
-                    let to_m = |c: [f64; 2]| [c[0] * p, h_m - c[1] * p];
+                    let to_m = |c: [f64; 2]| [c[0] * p, (h_px - c[1]) * p];
                     for (k, fd) in found.into_iter().enumerate() {
-                        if let Some([c1, c2]) = fd {
-                            if !t.post {
-                                tracks[k].1 += 1;
-                            }
-                            tracks[k].0.push(Frame {
+                        let Some(pair) = fd else { continue };
+                        if !t.post {
+                            tracks[k].1 += 1;
+                        }
+                        tracks[k].0.push(Frame {
+                            t_s: t.t_s,
+                            r1_m: to_m(pair[0].centre),
+                            r2_m: to_m(pair[1].centre),
+                        });
+                        for (i, s) in pair.iter().enumerate() {
+                            // The spin module works y up.
+                            let up = |c: [f64; 2]| [c[0], h_px - c[1]];
+                            let pts: Vec<[f64; 2]> = s.markers.iter().map(|&m| up(m)).collect();
+                            marks[k][i][phase].push(MarkerFrame {
                                 t_s: t.t_s,
-                                r1_m: to_m(c1),
-                                r2_m: to_m(c2),
+                                dirs: lift(up(s.centre), s.radius, &pts, LIFT_MAX_FRAC),
                             });
                         }
                     }
@@ -364,6 +406,17 @@ fn e_study(rng: &mut StdRng) -> Vec<ERow> {
                     {
                         rel[k].push(e / sim.e - 1.0);
                     }
+                    for i in 0..2 {
+                        for ph in 0..2 {
+                            let mf = &marks[k][i][ph];
+                            if mf.iter().all(|m| m.dirs.is_empty()) {
+                                continue;
+                            }
+                            if let Some(wz) = phase_spin(mf, SPIN_TOL_RAD).wz() {
+                                spin_err[k].push(wz - true_wz[i][ph]);
+                            }
+                        }
+                    }
                 }
             }
             for (k, label) in labels.iter().enumerate() {
@@ -371,6 +424,7 @@ fn e_study(rng: &mut StdRng) -> Vec<ERow> {
                 let m = r.len().max(1) as f64;
                 let mut abs: Vec<f64> = r.iter().map(|x| x.abs()).collect();
                 abs.sort_by(f64::total_cmp);
+                let se = &spin_err[k];
                 rows.push(ERow {
                     v_n: v,
                     exposure_s: exposure,
@@ -379,6 +433,12 @@ fn e_study(rng: &mut StdRng) -> Vec<ERow> {
                     measured: r.len(),
                     rms_rel: (r.iter().map(|x| x * x).sum::<f64>() / m).sqrt(),
                     median_abs_rel: abs.get(abs.len() / 2).copied().unwrap_or(f64::NAN),
+                    spins: se.len(),
+                    spin_rms_rad_s: if se.is_empty() {
+                        f64::NAN
+                    } else {
+                        (se.iter().map(|x| x * x).sum::<f64>() / se.len() as f64).sqrt()
+                    },
                 });
             }
             eprintln!("e study: v_n = {v} m/s, exposure {exposure} s done");
@@ -442,6 +502,8 @@ fn main() -> Result<(), String> {
         "measured",
         "rms_rel_e",
         "median_abs_rel_e",
+        "spins_measured",
+        "spin_rms_err_rad_s",
     ])
     .map_err(|e| e.to_string())?;
     for r in &e_rows {
@@ -453,6 +515,8 @@ fn main() -> Result<(), String> {
             r.measured.to_string(),
             fmt_num(r.rms_rel),
             fmt_num(r.median_abs_rel),
+            r.spins.to_string(),
+            if r.spins > 0 { fmt_num(r.spin_rms_rad_s) } else { String::new() },
         ])
         .map_err(|e| e.to_string())?;
     }

@@ -22,6 +22,14 @@ pub struct Panel {
     pub references: Vec<(String, f64)>,
 }
 
+/// An axis number: at most 3 significant digits, no trailing zeros.
+fn fmt_axis(x: f64) -> String {
+    let s = format!("{:.3}", x);
+    let s = if x.abs() >= 1.0 { format!("{:.1}", x) } else { s };
+    let s = s.trim_end_matches('0').trim_end_matches('.').to_string();
+    if s.is_empty() || s == "-" { "0".into() } else { s }
+}
+
 /// Renders panels in a grid of `columns` as one SVG; every y axis is logarithmic. Series with the
 /// same label have the same colour in every panel.
 pub fn accuracy_svg(panels: &[Panel], columns: usize, title: &str) -> Result<String, String> {
@@ -82,6 +90,10 @@ pub fn accuracy_svg(panels: &[Panel], columns: usize, title: &str) -> Result<Str
                     let mut chart = $chart;
                     chart
                         .configure_mesh()
+                        .x_labels(6)
+                        .y_labels(6)
+                        .x_label_formatter(&|x| format!("{}", fmt_axis(*x)))
+                        .y_label_formatter(&|y| format!("{}", fmt_axis(*y)))
                         .x_desc(panel.x_desc.as_str())
                         .y_desc(panel.y_desc.as_str())
                         .axis_desc_style(("sans-serif", 19))
@@ -134,7 +146,7 @@ pub fn accuracy_svg(panels: &[Panel], columns: usize, title: &str) -> Result<Str
                             )
                             .map_err(e)?;
                     }
-                    super::legend(&mut chart, SeriesLabelPosition::UpperLeft, 15)?;
+                    super::legend(&mut chart, SeriesLabelPosition::UpperRight, 15)?;
                 }};
             }
             if panel.log_x {
