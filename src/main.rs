@@ -26,6 +26,8 @@ enum Command {
     Kinematics(cli::kinematics::Args),
     /// A virtual experiment: simulated tracks of collisions seen by a high-speed camera
     Simulate(cli::simulate::Args),
+    /// Sphere centres and spins from video frames, one directory per collision (Sec. III)
+    Track(cli::track::Args),
     /// Walton's collision operator: fit e, beta_0 and mu_0 to oblique collisions (Fig. 6)
     Walton(cli::walton::Args),
 }
@@ -64,6 +66,7 @@ fn main() -> ExitCode {
         Command::Walton(args) => cli::walton::run(args),
         Command::Kinematics(args) => cli::kinematics::run(args),
         Command::Simulate(args) => cli::simulate::run(args),
+        Command::Track(args) => cli::track::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -9,6 +9,7 @@ pub mod frames_out;
 pub mod kinematics;
 pub mod predict;
 pub mod simulate;
+pub mod track;
 pub mod walton;
 
 /// What a subcommand returns: `Err` is one line for stderr (the binary prefixes it and exits 1).

@@ -6,6 +6,8 @@
 //! miscount after comment and blank lines, so we split lines ourselves and let csv parse each).
 //! Errors name the file, line, column and value: `data.csv:14: column 'e': '0,97' is not a number`.
 
+pub mod frames;
+pub mod images;
 pub mod png;
 pub mod tracks;
 

@@ -3,7 +3,8 @@
 //! Columns (header, any order): `collision` (an id), `t_s`, `x1_m,y1_m,x2_m,y2_m` (centres),
 //! `d1_mm,d2_mm`; optional `phase` (`pre`/`post`; when absent the split is found from the
 //! tracks), optional spins measured from markers `w1z_rad_s,w2z_rad_s` (before) and
-//! `w1z_post_rad_s,w2z_post_rad_s` (after), constant within a collision.
+//! `w1z_post_rad_s,w2z_post_rad_s` (after), constant within a collision. An empty spin cell
+//! (a sphere whose spin was not measured) is read as 0.
 
 use super::{DataError, Table, fmt_num};
 use crate::kinematics::Frame;
@@ -167,18 +168,30 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
 }
 
 /// Writes tracks in this schema (with `phase` when every track knows its split, and the spin
-/// columns when any track has spins). Numbers in shortest round-trip form.
+/// columns when any track has spins; a NaN spin, one not measured, is an empty cell). Numbers
+/// in shortest round-trip form; csv::Writer quotes ids that need it.
 pub fn write_tracks(tracks: &[CollisionTrack]) -> String {
     let phases = tracks.iter().all(|t| t.split.is_some());
     let spins = tracks.iter().any(|t| t.spins_rad_s.is_some());
-    let mut s = String::from("collision,t_s,x1_m,y1_m,x2_m,y2_m,d1_mm,d2_mm");
+    let mut header: Vec<&str> = vec![
+        "collision",
+        "t_s",
+        "x1_m",
+        "y1_m",
+        "x2_m",
+        "y2_m",
+        "d1_mm",
+        "d2_mm",
+    ];
     if phases {
-        s += ",phase";
+        header.push("phase");
     }
     if spins {
-        s += &format!(",{}", SPIN_COLUMNS.join(","));
+        header.extend(SPIN_COLUMNS);
     }
-    s += "\n";
+    let mut w = csv::Writer::from_writer(Vec::new());
+    // Writing to memory cannot fail.
+    w.write_record(&header).expect("in-memory CSV");
     for t in tracks {
         for (k, f) in t.frames.iter().enumerate() {
             let mut row = vec![
@@ -195,12 +208,18 @@ pub fn write_tracks(tracks: &[CollisionTrack]) -> String {
                 row.push(if k < split { "pre" } else { "post" }.to_string());
             }
             if spins {
-                row.extend(t.spins_rad_s.unwrap_or([0.0; 4]).map(fmt_num));
+                row.extend(t.spins_rad_s.unwrap_or([f64::NAN; 4]).map(|w| {
+                    if w.is_nan() {
+                        String::new()
+                    } else {
+                        fmt_num(w)
+                    }
+                }));
             }
-            s += &(row.join(",") + "\n");
+            w.write_record(&row).expect("in-memory CSV");
         }
     }
-    s
+    String::from_utf8(w.into_inner().expect("in-memory CSV")).expect("UTF-8 in, UTF-8 out")
 }
 
 #[cfg(test)]
@@ -233,6 +252,14 @@ mod tests {
         assert_eq!(again[0].split, t[0].split);
         assert_eq!(again[0].spins_rad_s, t[0].spins_rad_s);
         assert_eq!(again[0].d1_m, t[0].d1_m);
+        // An unmeasured spin is written empty and read back as 0; an id with a comma is quoted.
+        t[0].spins_rad_s = Some([1.0, f64::NAN, 3.0, -4.5]);
+        t[0].id = "a,b".into();
+        let text = write_tracks(&t);
+        assert!(text.contains("\"a,b\""), "{text}");
+        let again = parse_tracks(&Table::parse("u.csv", &text).unwrap()).unwrap();
+        assert_eq!(again[0].id, "a,b");
+        assert_eq!(again[0].spins_rad_s, Some([1.0, 0.0, 3.0, -4.5]));
     }
 
     #[test]

@@ -73,9 +73,13 @@ pub struct FrameDetection {
 pub enum DetectError {
     Coarse(CoarseError),
     /// More than two sphere-sized blobs (or maxima): not a two-sphere frame.
-    TooManyBlobs { n: usize },
+    TooManyBlobs {
+        n: usize,
+    },
     /// Seeds were found but no circle could be fitted to any.
-    NoFit { reasons: Vec<String> },
+    NoFit {
+        reasons: Vec<String>,
+    },
 }
 
 impl std::fmt::Display for DetectError {
@@ -83,7 +87,10 @@ impl std::fmt::Display for DetectError {
         match self {
             DetectError::Coarse(e) => write!(f, "{e}"),
             DetectError::TooManyBlobs { n } => {
-                write!(f, "{n} sphere-sized blobs where at most 2 spheres were expected")
+                write!(
+                    f,
+                    "{n} sphere-sized blobs where at most 2 spheres were expected"
+                )
             }
             DetectError::NoFit { reasons } => {
                 write!(f, "no sphere could be fitted: {}", reasons.join("; "))
@@ -271,11 +278,11 @@ pub fn detect_frame(img: &GrayImage, s: &DetectSettings) -> Result<FrameDetectio
                     &rf.fit.circle,
                     pts.iter().zip(&rf.inliers).filter(|x| *x.1).map(|x| *x.0),
                 );
-                let known = s
-                    .known_radii_px
-                    .iter()
-                    .copied()
-                    .min_by(|a, b| (a - rf.fit.circle.r).abs().total_cmp(&(b - rf.fit.circle.r).abs()));
+                let known = s.known_radii_px.iter().copied().min_by(|a, b| {
+                    (a - rf.fit.circle.r)
+                        .abs()
+                        .total_cmp(&(b - rf.fit.circle.r).abs())
+                });
                 if let (true, Some(r)) = (cov < s.free_coverage_deg, known) {
                     fit = fit_points(&edges, Some(r), s.min_edge_points);
                 }
@@ -308,6 +315,23 @@ pub fn detect_frame(img: &GrayImage, s: &DetectSettings) -> Result<FrameDetectio
             }
         };
         let c = rf.fit.circle;
+        // The passes may walk off (a short arc, a wrong edge): a circle far from its seed is
+        // not this sphere.
+        let seed = co.seeds[i].circle;
+        if (c.cx - seed.cx).hypot(c.cy - seed.cy) > 0.5 * seed.r + 3.0
+            || !(c.r > 0.5 * seed.r && c.r < 1.5 * seed.r + 3.0)
+        {
+            left_out.push(format!(
+                "{place}: the edge fit ({:.1}, {:.1}, r {:.1}) strayed from the blob ({:.1}, {:.1}, r {:.1})",
+                c.cx,
+                h - c.cy,
+                c.r,
+                seed.cx,
+                h - seed.cy,
+                seed.r
+            ));
+            continue;
+        }
         let cov = coverage_deg(
             &c,
             edges

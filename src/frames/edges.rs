@@ -285,7 +285,11 @@ mod tests {
             // Linear interpolation is an extra blur (a triangle of variance 1/6 px^2) that lowers
             // the peak by 4-7% here: within 10% of the smoothed continuous profile's slope.
             let want = smoothed_tanh_slope(b, s.sigma);
-            assert!((p.strength - want).abs() < 0.1 * want, "{} vs {want}", p.strength);
+            assert!(
+                (p.strength - want).abs() < 0.1 * want,
+                "{} vs {want}",
+                p.strength
+            );
             // Opposite polarity sees no positive peak on this profile.
             assert!(ray_edge(&img, [10.0, 4.5], 0.0, 5.0, 35.0, -1.0, &k, &s, &mut buf).is_none());
         }

@@ -38,9 +38,10 @@ impl GrayImage {
 }
 
 pub mod circle;
-pub mod edges;
-pub mod segment;
-pub mod markers;
 pub mod detect;
+pub mod edges;
+pub mod markers;
+pub mod segment;
 pub mod spin;
+pub mod track;
 pub mod render;

@@ -94,7 +94,8 @@ fn coarse_image(img: &GrayImage, factor: usize) -> GrayImage {
         for c in 0..w {
             let mut s = 0.0f32;
             for rr in r * factor..(r + 1) * factor {
-                let row = &img.pixels[rr * img.width + c * factor..rr * img.width + (c + 1) * factor];
+                let row =
+                    &img.pixels[rr * img.width + c * factor..rr * img.width + (c + 1) * factor];
                 s += row.iter().sum::<f32>();
             }
             out.pixels[r * w + c] = s * inv;
@@ -137,7 +138,11 @@ pub fn otsu(values: &[f32]) -> f32 {
         hist[((v - lo) * scale) as usize] += 1;
     }
     let total = values.len() as f64;
-    let sum_all: f64 = hist.iter().enumerate().map(|(i, &n)| i as f64 * n as f64).sum();
+    let sum_all: f64 = hist
+        .iter()
+        .enumerate()
+        .map(|(i, &n)| i as f64 * n as f64)
+        .sum();
     let (mut w0, mut sum0, mut best, mut best_i) = (0.0, 0.0, -1.0, 0usize);
     for (i, &n) in hist.iter().enumerate() {
         w0 += n as f64;
@@ -185,7 +190,9 @@ fn eval_background(a: &[f64; 6], w: usize, h: usize) -> Vec<f32> {
         let y = 2.0 * (r as f64 + 0.5) / h as f64 - 1.0;
         for c in 0..w {
             let x = 2.0 * (c as f64 + 0.5) / w as f64 - 1.0;
-            out.push((a[0] + a[1] * x + a[2] * y + a[3] * x * x + a[4] * x * y + a[5] * y * y) as f32);
+            out.push(
+                (a[0] + a[1] * x + a[2] * y + a[3] * x * x + a[4] * x * y + a[5] * y * y) as f32,
+            );
         }
     }
     out
@@ -200,7 +207,10 @@ pub fn coarse(img: &GrayImage, max_pixels: usize) -> Result<Coarse, CoarseError>
             height: h0,
         });
     }
-    let factor = ((w0 * h0) as f64 / max_pixels as f64).sqrt().ceil().max(1.0) as usize;
+    let factor = ((w0 * h0) as f64 / max_pixels as f64)
+        .sqrt()
+        .ceil()
+        .max(1.0) as usize;
     let cimg = coarse_image(img, factor);
     let (w, h) = (cimg.width, cimg.height);
     let noise = noise_sigma(img);
@@ -600,7 +610,11 @@ mod tests {
                 .filter(|&j| !fg[j])
                 .map(|j| (r - (j / w) as f64).hypot(c - (j % w) as f64))
                 .fold(f64::INFINITY, f64::min);
-            assert!((d[i] as f64 - brute).abs() < 1e-5, "pixel {i}: {} vs {brute}", d[i]);
+            assert!(
+                (d[i] as f64 - brute).abs() < 1e-5,
+                "pixel {i}: {} vs {brute}",
+                d[i]
+            );
         }
     }
 
@@ -639,7 +653,9 @@ mod tests {
         let a = 0.05;
         let mut img = GrayImage::filled(w, h, 0.5);
         for p in img.pixels.iter_mut() {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             let u = (state >> 11) as f64 / (1u64 << 53) as f64;
             *p = (0.5 + a * (2.0 * u - 1.0)) as f32;
         }

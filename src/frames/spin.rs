@@ -54,7 +54,12 @@ pub struct MarkerFrame {
 
 /// Lifts image markers (pixels, y up) of a disc (centre, radius) onto the unit sphere. Markers
 /// beyond `max_frac` of the radius are dropped: near the limb z is ill-determined.
-pub fn lift(centre: [f64; 2], radius: f64, markers: &[[f64; 2]], max_frac: f64) -> Vec<Vector3<f64>> {
+pub fn lift(
+    centre: [f64; 2],
+    radius: f64,
+    markers: &[[f64; 2]],
+    max_frac: f64,
+) -> Vec<Vector3<f64>> {
     markers
         .iter()
         .filter_map(|m| {
@@ -168,7 +173,8 @@ pub fn pair_rotation(
             None => true,
             Some((n, d, e, _)) => {
                 m.len() > *n
-                    || (m.len() == *n && (dist < d - 1e-6 || ((dist - d).abs() <= 1e-6 && rms < *e)))
+                    || (m.len() == *n
+                        && (dist < d - 1e-6 || ((dist - d).abs() <= 1e-6 && rms < *e)))
             }
         };
         if better {
@@ -220,7 +226,11 @@ fn weighted(rates: &[(f64, f64)]) -> (f64, Option<f64>) {
     if rates.len() < 2 {
         return (mean, None);
     }
-    let var = rates.iter().map(|r| r.1 * (r.0 - mean).powi(2)).sum::<f64>() / tw;
+    let var = rates
+        .iter()
+        .map(|r| r.1 * (r.0 - mean).powi(2))
+        .sum::<f64>()
+        / tw;
     (mean, Some((var / (rates.len() - 1) as f64).sqrt()))
 }
 
@@ -380,7 +390,11 @@ mod tests {
                 let ang = 0.3 + wz * t;
                 MarkerFrame {
                     t_s: t,
-                    dirs: vec![Vector3::new(0.5 * ang.cos(), 0.5 * ang.sin(), 0.75f64.sqrt())],
+                    dirs: vec![Vector3::new(
+                        0.5 * ang.cos(),
+                        0.5 * ang.sin(),
+                        0.75f64.sqrt(),
+                    )],
                 }
             })
             .collect();
@@ -401,7 +415,12 @@ mod tests {
 
     #[test]
     fn lift_puts_markers_on_the_unit_sphere() {
-        let v = lift([10.0, 20.0], 5.0, &[[12.0, 21.5], [10.0, 20.0], [14.9, 20.0]], 0.9);
+        let v = lift(
+            [10.0, 20.0],
+            5.0,
+            &[[12.0, 21.5], [10.0, 20.0], [14.9, 20.0]],
+            0.9,
+        );
         assert_eq!(v.len(), 2);
         assert!((v[0] - Vector3::new(0.4, 0.3, 0.75f64.sqrt())).norm() < 1e-12);
         assert!((v[1] - Vector3::new(0.0, 0.0, 1.0)).norm() < 1e-12);

@@ -100,7 +100,11 @@ impl Scene {
             }
             let body = b.attitude.inverse() * n;
             let on_marker = b.markers.iter().any(|m| body.dot(m) > b.marker_rad.cos());
-            let albedo = if on_marker { self.marker_albedo } else { b.albedo };
+            let albedo = if on_marker {
+                self.marker_albedo
+            } else {
+                b.albedo
+            };
             return albedo * light;
         }
         self.background(x, y)
@@ -164,5 +168,87 @@ pub fn ball(centre: [f64; 2], radius: f64, n_markers: usize) -> Ball {
         marker_rad: 0.12,
         attitude: Rotation3::identity(),
         albedo: 1.0,
+    }
+}
+
+/// A head-on-ish collision filmed at 1000 frames/s: two spheres of radius `r` pixels meet at
+/// frame `t_c` (fractional), e = 0.9, with known spins (rad/s, x right, y up, z to the camera)
+/// before and after. Frame numbers start at 100; `skip` frame numbers are not rendered.
+pub struct Sequence {
+    pub fps: f64,
+    /// (frame number, scene, centres (x, y) px of sphere 1 and 2).
+    pub frames: Vec<(i64, Scene, [[f64; 2]; 2])>,
+    /// spins[sphere][phase] (phase 0 before, 1 after), rad/s.
+    pub spins: [[Vector3<f64>; 2]; 2],
+    pub t_c_frames: f64,
+}
+
+pub fn collision_sequence(r: f64, t_c: f64, n: i64, skip: &[i64]) -> Sequence {
+    let fps = 1000.0;
+    let n_hat = [0.6, -0.8];
+    let mid = [96.0, 120.0];
+    let c_at = [
+        [mid[0] - r * n_hat[0], mid[1] - r * n_hat[1]],
+        [mid[0] + r * n_hat[0], mid[1] + r * n_hat[1]],
+    ];
+    let v = [[3.0, -4.0], [-3.0, 4.0]];
+    let e = 0.9;
+    let vrel = [v[0][0] - v[1][0], v[0][1] - v[1][1]];
+    let vpost = [
+        [
+            v[0][0] - (1.0 + e) / 2.0 * vrel[0],
+            v[0][1] - (1.0 + e) / 2.0 * vrel[1],
+        ],
+        [
+            v[1][0] + (1.0 + e) / 2.0 * vrel[0],
+            v[1][1] + (1.0 + e) / 2.0 * vrel[1],
+        ],
+    ];
+    let spins = [
+        [
+            Vector3::new(10.0, -20.0, 60.0),
+            Vector3::new(10.0, -20.0, -40.0),
+        ],
+        [
+            Vector3::new(0.0, 30.0, -50.0),
+            Vector3::new(5.0, 25.0, 70.0),
+        ],
+    ];
+    let att0 = [
+        Rotation3::from_euler_angles(0.3, -0.2, 0.5),
+        Rotation3::from_euler_angles(-0.4, 0.1, 1.1),
+    ];
+    let mut frames = Vec::new();
+    for k in 0..n {
+        let number = 100 + k;
+        if skip.contains(&number) {
+            continue;
+        }
+        let dt = k as f64 - t_c;
+        let phase = usize::from(dt > 0.0);
+        let mut balls = Vec::new();
+        let mut centres = [[0.0; 2]; 2];
+        for s in 0..2 {
+            let vel = if phase == 0 { v[s] } else { vpost[s] };
+            let c = [c_at[s][0] + vel[0] * dt, c_at[s][1] + vel[1] * dt];
+            centres[s] = c;
+            let att = Rotation3::from_scaled_axis(spins[s][phase] * (dt / fps)) * att0[s];
+            let mut b = ball(c, r, 12);
+            b.marker_rad = 0.15;
+            b.attitude = att;
+            // Half a frame of exposure at this velocity: slight motion blur.
+            b.blur = [0.3 * vel[0], 0.3 * vel[1]];
+            balls.push(b);
+        }
+        let mut sc = Scene::paper_like(192, 239, balls);
+        sc.blur_steps = 3;
+        sc.seed = number as u64;
+        frames.push((number, sc, centres));
+    }
+    Sequence {
+        fps,
+        frames,
+        spins,
+        t_c_frames: t_c,
     }
 }
