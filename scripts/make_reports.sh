@@ -33,5 +33,5 @@ $B simulate --material nylon --camera-study --incidence-deg 0,45 --out reports/k
 # Bench (issue 4): work-precision chart, stability map, fit accuracy, targets (timings vary by machine).
 $B bench --out reports/bench > /dev/null
 
-# Frames (issue "Frames", item 6): accuracy of the frame pipeline on rendered frames (~5 min on 2 cores).
+# Frames (issue "Frames", item 6): accuracy of the frame pipeline on rendered frames (10-15 min on 2 cores).
 cargo run --release --quiet --example frames_accuracy > /dev/null

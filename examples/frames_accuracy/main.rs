@@ -516,7 +516,11 @@ fn main() -> Result<(), String> {
             fmt_num(r.rms_rel),
             fmt_num(r.median_abs_rel),
             r.spins.to_string(),
-            if r.spins > 0 { fmt_num(r.spin_rms_rad_s) } else { String::new() },
+            if r.spins > 0 {
+                fmt_num(r.spin_rms_rad_s)
+            } else {
+                String::new()
+            },
         ])
         .map_err(|e| e.to_string())?;
     }
@@ -544,6 +548,20 @@ fn main() -> Result<(), String> {
             r.stats.rms * SUBPIXELS_PER_PIXEL,
             r.stats.p95,
             r.stats.failed
+        );
+    }
+    for r in &e_rows {
+        println!(
+            "e: v_n {} m/s, exposure {} s, {}: {}/{} measured, rms {:.5}, median |rel| {:.5}; {} spins, rms error {:.3} rad/s",
+            r.v_n,
+            r.exposure_s,
+            r.method,
+            r.measured,
+            r.simulated,
+            r.rms_rel,
+            r.median_abs_rel,
+            r.spins,
+            r.spin_rms_rad_s
         );
     }
     println!(

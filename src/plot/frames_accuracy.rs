@@ -25,9 +25,17 @@ pub struct Panel {
 /// An axis number: at most 3 significant digits, no trailing zeros.
 fn fmt_axis(x: f64) -> String {
     let s = format!("{:.3}", x);
-    let s = if x.abs() >= 1.0 { format!("{:.1}", x) } else { s };
+    let s = if x.abs() >= 1.0 {
+        format!("{:.1}", x)
+    } else {
+        s
+    };
     let s = s.trim_end_matches('0').trim_end_matches('.').to_string();
-    if s.is_empty() || s == "-" { "0".into() } else { s }
+    if s.is_empty() || s == "-" {
+        "0".into()
+    } else {
+        s
+    }
 }
 
 /// Renders panels in a grid of `columns` as one SVG; every y axis is logarithmic. Series with the
