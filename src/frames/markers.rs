@@ -3,8 +3,9 @@
 //!
 //! A pixel is a marker candidate when it is darker than the mean of the disc pixels around it
 //! (a box of half the radius, restricted to the disc so the background beyond the limb does
-//! not count) by more than `max(5 sigma_noise, 0.1 contrast)`. Connected candidates form a dot;
-//! its position is the darkness-weighted centroid (subpixel). Only the inner 80% of the radius
+//! not count) by more than `max(5 sigma_noise, 0.1 contrast)`. Connected candidates form a dot
+//! if on average they are 30% darker than the surface around them; its position is the centroid
+//! on the sphere (subpixel; see `find_markers`). Only the inner 80% of the radius
 //! is searched: towards the limb the shading falls steeply and would mimic dots, and a dot seen
 //! edge-on is too foreshortened to place well.
 
@@ -21,6 +22,10 @@ pub struct Marker {
     /// Mean darkness against the surrounding disc, intensity units.
     pub depth: f64,
 }
+
+/// A dot must be at least this much darker than the surface around it, relative to that
+/// surface's brightness.
+pub const MIN_RELATIVE_DEPTH: f64 = 0.3;
 
 /// Fraction of the radius searched for markers.
 pub const SEARCH_FRACTION: f64 = 0.8;
@@ -52,7 +57,7 @@ pub fn find_markers(img: &GrayImage, disc: &Circle, noise: f64, contrast: f64) -
     let thr = (5.0 * noise).max(0.1 * contrast);
     let pix = |c: usize, rr: usize| img.get(c0 as usize + c, r0 as usize + rr) as f64;
     // Darkness against the local mean of the disc pixels in `use_px`, by integral images.
-    let darkness = |use_px: &dyn Fn(usize, usize) -> bool| -> Vec<f64> {
+    let darkness = |use_px: &dyn Fn(usize, usize) -> bool| -> (Vec<f64>, Vec<f64>) {
         let stride = bw + 1;
         let mut si = vec![0.0f64; stride * (bh + 1)];
         let mut sm = vec![0.0f64; stride * (bh + 1)];
@@ -73,6 +78,7 @@ pub fn find_markers(img: &GrayImage, disc: &Circle, noise: f64, contrast: f64) -
             s[b1 * stride + a1] - s[b0 * stride + a1] - s[b1 * stride + a0] + s[b0 * stride + a0]
         };
         let mut dark = vec![0.0f64; bw * bh];
+        let mut level = vec![0.0f64; bw * bh];
         for rr in 0..bh {
             for c in 0..bw {
                 if !inside(c, rr, SEARCH_FRACTION) {
@@ -80,16 +86,18 @@ pub fn find_markers(img: &GrayImage, disc: &Circle, noise: f64, contrast: f64) -
                 }
                 let n = box_sum(&sm, c, rr);
                 if n >= 1.0 {
-                    dark[rr * bw + c] = (box_sum(&si, c, rr) / n - pix(c, rr)).max(0.0);
+                    let mean = box_sum(&si, c, rr) / n;
+                    level[rr * bw + c] = mean;
+                    dark[rr * bw + c] = (mean - pix(c, rr)).max(0.0);
                 }
             }
         }
-        dark
+        (dark, level)
     };
     // Pass 1 finds the dots against a mean that they darken themselves; pass 2 takes the mean
     // without them (and their one-pixel rim), so the weights of partly covered rim pixels are
     // their true darkness and the centroid is not pulled.
-    let first = darkness(&|c, rr| inside(c, rr, 0.95));
+    let (first, _) = darkness(&|c, rr| inside(c, rr, 0.95));
     let mut dotted = vec![false; bw * bh];
     for i in (0..bw * bh).filter(|&i| first[i] > thr) {
         dotted[i] = true;
@@ -97,7 +105,7 @@ pub fn find_markers(img: &GrayImage, disc: &Circle, noise: f64, contrast: f64) -
             dotted[j] = true;
         }
     }
-    let dark = darkness(&|c, rr| inside(c, rr, 0.95) && !dotted[rr * bw + c]);
+    let (dark, level) = darkness(&|c, rr| inside(c, rr, 0.95) && !dotted[rr * bw + c]);
     // Connected dots (8-neighbours: a small dot drawn at an angle may touch only diagonally).
     let max_area = (0.1 * std::f64::consts::PI * r * r) as usize;
     let above = |i: usize| dark[i] > thr;
@@ -124,27 +132,50 @@ pub fn find_markers(img: &GrayImage, disc: &Circle, noise: f64, contrast: f64) -
             }
         }
         let n = members.len();
-        // The centroid weighs the dot's pixels and its one-pixel rim by their darkness: the rim
-        // holds the partly covered pixels below the threshold, which a centroid of the
-        // thresholded pixels alone would cut asymmetrically.
-        let (mut sw, mut su, mut sv) = (0.0, 0.0, 0.0);
+        // The dot's centre is the centroid on the sphere, not in the image: each pixel (the
+        // dot's and its one-pixel rim, which holds the partly covered pixels below the
+        // threshold) is lifted to the sphere and weighted by its covered fraction (darkness over
+        // the local surface brightness: shading cancels) times the surface area it spans (R/z:
+        // foreshortening). An image centroid would sit nearer the disc centre than the dot
+        // (its limb side is foreshortened and less lit) and shrink every turn about x or y.
+        let mut acc = [0.0f64; 3];
+        let mut frac_sum = 0.0;
+        for &i in &members {
+            frac_sum += if level[i] > 1e-6 {
+                dark[i] / level[i]
+            } else {
+                1.0
+            };
+        }
         for &i in &members {
             for j in std::iter::once(i).chain(neighbours8(i, bw, bh)) {
                 if weighed[j] == start {
                     continue;
                 }
                 weighed[j] = start;
-                let d = dark[j];
-                sw += d;
-                su += d * ((c0 as usize + j % bw) as f64 + 0.5);
-                sv += d * ((r0 as usize + j / bw) as f64 + 0.5);
+                let frac = if level[j] > 1e-6 {
+                    dark[j] / level[j]
+                } else {
+                    dark[j]
+                };
+                let dx = (c0 as usize + j % bw) as f64 + 0.5 - disc.cx;
+                let dy = (r0 as usize + j / bw) as f64 + 0.5 - disc.cy;
+                // Pixels are inside 95% of the radius, so z >= 0.31 R: no blow-up.
+                let z = (r * r - dx * dx - dy * dy).max(0.01 * r * r).sqrt();
+                let w = frac * r / z;
+                acc[0] += w * dx / r;
+                acc[1] += w * dy / r;
+                acc[2] += w * z / r;
             }
         }
-        // One pixel is noise; more than a tenth of the disc is shading or a shadow, not a dot.
-        if n >= 2 && n <= max_area && sw > 0.0 {
+        let norm = (acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2]).sqrt();
+        // One pixel is noise; more than a tenth of the disc is shading or a shadow, not a dot;
+        // a printed dot is much darker than the surface around it (the paper's are black), while
+        // the curvature of the shading towards a dim limb makes shallow dips of 10-20%.
+        if n >= 2 && n <= max_area && norm > 0.0 && frac_sum / n as f64 >= MIN_RELATIVE_DEPTH {
             out.push(Marker {
-                u: su / sw,
-                v: sv / sw,
+                u: disc.cx + r * acc[0] / norm,
+                v: disc.cy + r * acc[1] / norm,
                 area_px: n,
                 depth: members.iter().map(|&i| dark[i]).sum::<f64>() / n as f64,
             });
@@ -167,11 +198,11 @@ fn neighbours8(i: usize, w: usize, h: usize) -> impl Iterator<Item = usize> {
 mod tests {
     use super::*;
 
-    // Two dots drawn as discs of darkness (pixel coverage by 16 x 16 supersampling) on a
-    // uniformly bright disc: the darkness-weighted centroid is the dot's centre up to the
-    // discretisation of weighting each partly covered pixel at its centre (the covered part's
-    // own centroid is elsewhere) and the supersampling; measured 0.011 px for a dot of radius
-    // 2.5 px. Bar: 0.02 px (the spins need about 0.1 px).
+    // Two dots drawn as spherical caps (angular radius 0.1 rad) on a Lambertian-shaded sphere
+    // (light from the camera: brightness z/R), 16 x 16 supersampled. The known answer is the
+    // projection of each cap's centre, (cx + R n_x, cy + R n_y): a cap is symmetric on the
+    // sphere, which the spherical centroid exploits. Measured 0.011 px (pixel-centre weighting
+    // of partly covered pixels, supersampling); bar 0.04 px.
     #[test]
     fn dots_found_at_their_centres() {
         let (w, h) = (80, 80);
@@ -180,7 +211,11 @@ mod tests {
             cy: 40.0,
             r: 30.0,
         };
-        let dots = [(31.3, 44.7), (48.6, 33.2)];
+        let dirs: [[f64; 3]; 2] = [[-0.25, 0.15, 0.0], [0.55, -0.3, 0.0]].map(|d| {
+            let z = (1.0f64 - d[0] * d[0] - d[1] * d[1]).sqrt();
+            [d[0], d[1], z]
+        });
+        let cos_a = 0.1f64.cos();
         let mut img = GrayImage::filled(w, h, 0.1);
         for r in 0..h {
             for c in 0..w {
@@ -189,14 +224,16 @@ mod tests {
                     for sx in 0..16 {
                         let u = c as f64 + (sx as f64 + 0.5) / 16.0;
                         let v = r as f64 + (sy as f64 + 0.5) / 16.0;
-                        let on_disc = (u - disc.cx).hypot(v - disc.cy) < disc.r;
-                        let on_dot = dots.iter().any(|d| (u - d.0).hypot(v - d.1) < 2.5);
-                        acc += if !on_disc {
+                        let (dx, dy) = ((u - disc.cx) / disc.r, (v - disc.cy) / disc.r);
+                        let rho2 = dx * dx + dy * dy;
+                        acc += if rho2 >= 1.0 {
                             0.1
-                        } else if on_dot {
-                            0.25
                         } else {
-                            0.8
+                            let z = (1.0 - rho2).sqrt();
+                            let on_dot = dirs
+                                .iter()
+                                .any(|n| n[0] * dx + n[1] * dy + n[2] * z > cos_a);
+                            (if on_dot { 0.15 } else { 0.9 }) * (0.2 + 0.8 * z)
                         };
                     }
                 }
@@ -205,12 +242,16 @@ mod tests {
         }
         let m = find_markers(&img, &disc, 0.0, 0.7);
         assert_eq!(m.len(), 2, "{m:?}");
-        for d in dots {
+        for n in dirs {
+            let want = (disc.cx + disc.r * n[0], disc.cy + disc.r * n[1]);
             let best = m
                 .iter()
-                .map(|k| (k.u - d.0).hypot(k.v - d.1))
+                .map(|k| (k.u - want.0).hypot(k.v - want.1))
                 .fold(f64::INFINITY, f64::min);
-            assert!(best < 0.02, "dot at {d:?}: nearest marker {best} px away");
+            assert!(
+                best < 0.04,
+                "dot at {want:?}: nearest marker {best} px away"
+            );
         }
     }
 
