@@ -50,3 +50,5 @@ $B export --engine lammps --material nylon --d-mm 6.35,25.4 --wall --eta 2000 --
 $B export reports/fit/params.json --engine table --v-range 0.5,40 --walton reports/walton/walton.json \
     --out reports/export/table > reports/export/table/report.txt
 cargo run --release --quiet --example tsuji_accuracy > reports/export/tsuji_accuracy.txt
+# Frames (issue "Frames", item 6): accuracy of the frame pipeline on rendered frames (10-15 min on 2 cores).
+cargo run --release --quiet --example frames_accuracy > /dev/null

@@ -7,6 +7,7 @@ use std::io::{self, Write};
 pub mod bench;
 pub mod export;
 pub mod fit;
+pub mod frames_out;
 pub mod kinematics;
 pub mod predict;
 pub mod simulate;

@@ -15,6 +15,7 @@ pub mod export;
 pub mod fit_input;
 pub mod frames;
 pub mod images;
+pub mod png;
 mod table;
 pub mod tracks;
 pub mod walton;
