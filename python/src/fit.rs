@@ -23,6 +23,9 @@ pub(crate) struct Fitted {
     rule: ContactEnd,
     vm_method: VmMethod,
     set: FitSet,
+    /// Seconds spent reading and fitting (for the speed benchmark's overhead measurement).
+    #[pyo3(get)]
+    rust_seconds: f64,
 }
 
 impl Fitted {
@@ -140,6 +143,7 @@ fn fit(
     let rule = crate::models::contact_end(contact_end);
     let source = Source::new(path, name, text);
     run_detached(py, move || {
+        let start = std::time::Instant::now();
         let (material, kinds, rule) = (material?, kinds?, rule?);
         let input = match source? {
             Source::Path(p) => read_fit_csv(&p, material, strict)?,
@@ -162,6 +166,7 @@ fn fit(
             rule,
             vm_method,
             set,
+            rust_seconds: start.elapsed().as_secs_f64(),
         })
     })
 }
