@@ -89,16 +89,6 @@ impl Fitted {
     fn input_warnings(&self) -> Vec<String> {
         self.input.warnings.iter().map(|w| w.to_string()).collect()
     }
-
-    /// The line of each observation in the file (for a table: row index + 2).
-    fn lines(&self) -> Vec<usize> {
-        self.input.lines.clone()
-    }
-
-    /// The source as named in the messages and the document.
-    fn path(&self) -> String {
-        self.input.path.clone()
-    }
 }
 
 fn models(name: &str) -> Outcome<Vec<ModelKind>> {

@@ -134,6 +134,9 @@ fn e_of_u<'py>(
 /// Named columns, in the order of `restitution predict --format csv`.
 type Columns = Vec<(&'static str, Vec<f64>)>;
 
+/// A column handed to Python.
+type NamedArray<'py> = (&'static str, Bound<'py, PyArray1<f64>>);
+
 /// Arguments of [`predict`] that describe the collision.
 struct Geometry {
     d_mm: Option<f64>,
@@ -200,7 +203,7 @@ fn predict<'py>(
     method: &str,
     tol: f64,
     full_output: bool,
-) -> PyResult<Vec<(&'static str, Bound<'py, PyArray1<f64>>)>> {
+) -> PyResult<Vec<NamedArray<'py>>> {
     let (v, kappa, u) = (
         v_m_s.as_ref().map(owned),
         kappa.as_ref().map(owned),
