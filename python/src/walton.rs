@@ -53,7 +53,8 @@ fn to_dict<'py>(
     d.set_item("mu0", estimate(py, &fit.mu0)?)?;
     d.set_item("slope", estimate(py, &fit.slope)?)?;
     d.set_item("psi_kink", estimate(py, &fit.kink_psi)?)?;
-    d.set_item("gamma0_deg", fit.gamma0_deg())?;
+    // The critical angle exists only when the kink is determined.
+    d.set_item("gamma0_deg", fit.converged.then(|| fit.gamma0_deg()))?;
     d.set_item("n", fit.n)?;
     d.set_item("n_sliding", fit.n_sliding)?;
     d.set_item("n_rolling", fit.n_rolling)?;
@@ -87,7 +88,13 @@ fn to_dict<'py>(
         "beta",
         c.iter().map(|c| c.measured.beta).collect::<Vec<_>>(),
     )?;
-    cols.set_item("psi", c.iter().map(|c| c.measured.psi).collect::<Vec<_>>())?;
+    // psi = +inf for a head-on collision: None, as the CLI's null.
+    cols.set_item(
+        "psi",
+        c.iter()
+            .map(|c| Some(c.measured.psi).filter(|p| p.is_finite()))
+            .collect::<Vec<_>>(),
+    )?;
     cols.set_item(
         "v_n_m_s",
         c.iter().map(|c| c.measured.v_n_m_s).collect::<Vec<_>>(),
