@@ -64,7 +64,7 @@ impl Failure {
         }
     }
 
-    fn into_pyerr(self, py: Python<'_>) -> PyErr {
+    pub(crate) fn into_pyerr(self, py: Python<'_>) -> PyErr {
         match self {
             Failure::Input(m) => InputError::new_err(m),
             Failure::Numerical(m) => NumericalError::new_err(m),

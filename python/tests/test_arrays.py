@@ -68,3 +68,19 @@ def test_ode_methods_agree_with_the_master_curve(method):
     kappa = np.logspace(-4, 1, 7)
     ode = rs.e_of_kappa(kappa, method=method, tol=1e-12)
     assert np.max(np.abs(ode - rs.e_of_kappa(kappa))) < 1e-9
+
+
+def test_long_and_strided_arrays_cross_the_chunks_correctly():
+    # The extension works through arrays in chunks of 32768 values: values on both sides of
+    # chunk ends, in a strided view, must come out in place, and a bad value deep in a later
+    # chunk must be reported with its own index.
+    kappa = np.logspace(-6, 2, 3 * 32768 + 5)
+    e = rs.e_of_kappa(kappa)
+    idx = [0, 32767, 32768, 65535, 65536, len(kappa) - 1]
+    assert [e[i] for i in idx] == [float(rs.e_of_kappa(kappa[i])) for i in idx]
+    assert np.array_equal(rs.e_of_kappa(kappa[::3]), e[::3])
+    assert np.array_equal(rs.e_of_u(kappa[::-1]), rs.e_of_u(kappa)[::-1])
+    bad = kappa.copy()
+    bad[70001] = -1.0
+    with pytest.raises(ValueError, match=r"^kappa\[70001\] = -1: expected a number >= 0$"):
+        rs.e_of_kappa(bad)
