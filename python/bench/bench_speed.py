@@ -1,13 +1,22 @@
-"""Speed of the Python package against the same Rust calls without Python (the example
-`python/examples/rust_baseline.rs`, run here with cargo).
+"""Speed of the Python package against the same library calls in Rust without Python.
 
-    python python/bench/bench_speed.py [--n 1000000] [--repeats 20] [--out python/bench/speed.md]
+    python python/bench/bench_speed.py [--n 1000000] [--repeats 30] [--out python/bench/speed.md]
 
-Both sides take the minimum over `repeats` runs (the least disturbed run on a shared machine).
-Measured: `e_of_kappa` on n values (numpy logspace(-4, 1, n), the master curve) against the
-Rust loop over the same values; `fit` of data/fig7_nylon.csv (all five models, and vm alone)
-against read + fit + JSON document in Rust. Ratios > 1 are the cost of the Python layer: the
-copy of the input, the validation pass, the array conversion, the JSON parse of the document.
+Three baselines, all the same library calls as the Python functions make:
+* paired: the extension's `_bench_loop_seconds` / `_bench_fit_seconds` (the plain loop
+  `restitution(kappa, Overlap, Master)` collected into a Vec; read + fit + JSON document) timed
+  in Rust, alternated with the Python calls, so each pair shares the machine's load; the median
+  of the per-pair ratios;
+* within one call: the Python call's wall time over the time the extension itself spent in the
+  library during that call (the loop; reading and fitting), median over the calls, and the
+  difference in microseconds (for `fit` it includes rendering and parsing the JSON document);
+* a separate process: the example `python/examples/rust_baseline.rs` (cargo run), minimum
+  over its runs, against the minimum of the Python calls. On a loaded machine the two minima
+  come from different moments, so this ratio is the least reliable of the three.
+
+Measured: `e_of_kappa` on n values (numpy logspace(-4, 1, n), the master curve) and `fit` of
+data/fig7_nylon.csv (all five models, and vm alone). A ratio above 1 is the cost of the Python
+layer: argument handling, chunked copies of the input, the JSON parse of the document.
 """
 
 import argparse
@@ -26,15 +35,7 @@ import restitution as rs
 
 ROOT = Path(__file__).resolve().parents[2]
 DATA = ROOT / "data" / "fig7_nylon.csv"
-
-
-def min_time(repeats, f):
-    best = float("inf")
-    for _ in range(repeats):
-        t = time.perf_counter()
-        f()
-        best = min(best, time.perf_counter() - t)
-    return best
+ext = rs._models._ext
 
 
 def median(xs):
@@ -42,39 +43,53 @@ def median(xs):
     return xs[len(xs) // 2]
 
 
-def in_call_ratios(kappa, repeats):
-    """Per call, total time of the Python function over the time of the Rust work inside it
-    (measured by the extension itself), so machine load hits both parts of one call alike;
-    the median over `repeats` calls."""
-    ext = rs._models._ext
+def measure(repeats, python_call, rust_seconds):
+    """Alternates the Python call (timed here, also returning the library time it reports)
+    with the Rust baseline; returns (min Python s, min Rust s, median paired ratio, median
+    within-call ratio)."""
+    py, rust, paired, within, extra = [], [], [], [], []
+    for _ in range(repeats):
+        t = time.perf_counter()
+        inner = python_call()
+        p = time.perf_counter() - t
+        r = rust_seconds()
+        py.append(p)
+        rust.append(r)
+        paired.append(p / r)
+        within.append(p / inner)
+        extra.append(p - inner)
+    return min(py), min(rust), median(paired), median(within), median(extra)
+
+
+def kappa_call(kappa):
     inner = {}
+    original = ext.e_of_kappa
 
     def timed(k, **kw):
         e, inner["s"] = ext.e_of_kappa_timed(k, **kw)
         return e
 
-    loop = []
-    original = ext.e_of_kappa
-    ext.e_of_kappa = timed
-    try:
-        for _ in range(repeats):
-            t = time.perf_counter()
+    def call():
+        ext.e_of_kappa = timed
+        try:
             rs.e_of_kappa(kappa)
-            loop.append((time.perf_counter() - t) / inner["s"])
-    finally:
-        ext.e_of_kappa = original
-    fits = {}
-    for model in ("all", "vm"):
-        ratios = []
-        for _ in range(repeats):
-            t = time.perf_counter()
-            r = rs.fit(str(DATA), "nylon", model=model)
-            ratios.append((time.perf_counter() - t) / r._fitted.rust_seconds)
-        fits[model] = median(ratios)
-    return median(loop), fits["all"], fits["vm"]
+        finally:
+            ext.e_of_kappa = original
+        return inner["s"]
+
+    return call
 
 
-def rust_baseline(n, repeats):
+def fit_call(model):
+    def call():
+        r = rs.fit(str(DATA), "nylon", model=model)
+        r.params  # the document rendered and parsed: what a user reading the result pays
+        return r._fitted.rust_seconds
+
+    return call
+
+
+def example(n, repeats):
     cmd = [
         "cargo", "run", "--quiet", "--release", "--manifest-path", str(ROOT / "python" / "Cargo.toml"),
         "--example", "rust_baseline", "--", str(DATA), str(n), str(repeats),
@@ -86,42 +101,35 @@ def rust_baseline(n, repeats):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--n", type=int, default=1_000_000)
-    ap.add_argument("--repeats", type=int, default=20)
+    ap.add_argument("--repeats", type=int, default=30)
     ap.add_argument("--out", type=Path, default=None)
     a = ap.parse_args()
-
-    rust = rust_baseline(a.n, a.repeats)
-    kappa = np.logspace(-4, 1, a.n)
-    py_loop = min_time(a.repeats, lambda: rs.e_of_kappa(kappa)) / a.n * 1e9
     warnings.simplefilter("ignore", rs.DataWarning)
-    py_all = min_time(a.repeats, lambda: rs.fit(str(DATA), "nylon")) * 1e3
-    py_vm = min_time(a.repeats, lambda: rs.fit(str(DATA), "nylon", model="vm")) * 1e3
 
-    inner = in_call_ratios(kappa, a.repeats)
+    process = example(a.n, a.repeats)
+    kappa = np.logspace(-4, 1, a.n)
     rows = [
-        (f"e_of_kappa, {a.n} values (ns per value)", rust["e_of_kappa_ns"], py_loop, inner[0]),
-        ("fit, all five models, 120 points (ms)", rust["fit_all_ms"], py_all, inner[1]),
-        ("fit, vm only, 120 points (ms)", rust["fit_vm_ms"], py_vm, inner[2]),
+        (f"e_of_kappa, {a.n} values (ns per value)", 1e9 / a.n, process["e_of_kappa_ns"],
+         measure(a.repeats, kappa_call(kappa), lambda: ext._bench_loop_seconds(kappa))),
+        ("fit, all five models, 120 points (ms)", 1e3, process["fit_all_ms"],
+         measure(a.repeats, fit_call("all"), lambda: ext._bench_fit_seconds(str(DATA), "all"))),
+        ("fit, vm only, 120 points (ms)", 1e3, process["fit_vm_ms"],
+         measure(a.repeats, fit_call("vm"), lambda: ext._bench_fit_seconds(str(DATA), "vm"))),
     ]
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     lines = [
-        f"Speed of the Python package against the same Rust calls "
-        f"(`python python/bench/bench_speed.py --n {a.n} --repeats {a.repeats}`; "
-        f"minimum over {a.repeats} runs; {platform.processor() or platform.machine()}, "
-        f"{os.cpu_count()} CPUs, Python {platform.python_version()}).",
+        f"Python against the same Rust calls (`python python/bench/bench_speed.py --n {a.n} "
+        f"--repeats {a.repeats}`; {platform.machine()}, {os.cpu_count()} CPUs, Python "
+        f"{platform.python_version()}, load average {load:.1f} at the end).",
         "",
-        "| what | Rust example | Python | ratio | ratio within one call |",
-        "| --- | --- | --- | --- | --- |",
+        "| what | Python (min) | Rust (min) | Python / Rust, paired (median) | within one call (median) | Python layer per call, us (median) | Rust example process (min) | ratio of minima to it |",
+        "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
-    for what, r, p, q in rows:
-        lines.append(f"| {what} | {r:.4g} | {p:.4g} | {p / r:.3f} | {q:.3f} |")
-    lines += [
-        "",
-        "Rust example: `python/examples/rust_baseline.rs`, a separate process (minimum over the "
-        "runs). Ratio within one call: the Python call's wall time over the time the extension "
-        "spent in the library inside that same call (the loop alone; reading and fitting), "
-        "median over the runs; robust to the load of a shared machine, which the ratio of two "
-        "separate minima is not.",
-    ]
+    for what, scale, proc_value, (py, rust, paired, within, extra) in rows:
+        lines.append(
+            f"| {what} | {py * scale:.4g} | {rust * scale:.4g} | {paired:.3f} | {within:.3f} "
+            f"| {extra * 1e6:.0f} | {proc_value:.4g} | {py * scale / proc_value:.3f} |"
+        )
     text = "\n".join(lines) + "\n"
     print(text)
     if a.out:

@@ -44,12 +44,28 @@ class FitResult:
 
     def __init__(self, fitted: Any, source_name: str):
         self._fitted = fitted
-        self._doc: Dict[str, Any] = json.loads(fitted.json())
         self._name = source_name
+        self._cache: Optional[Dict[str, Any]] = None
         self.warnings: List[str] = fitted.input_warnings()
-        self.preferred: Optional[str] = self._doc["preferred"]
-        self.models: List[str] = [f["model"] for f in self._doc["fits"]]
-        self.params: Dict[str, Dict[str, Dict[str, Any]]] = {
+
+    @property
+    def _doc(self) -> Dict[str, Any]:
+        # Rendered and parsed on first use: a fit in a loop that reads nothing pays nothing.
+        if self._cache is None:
+            self._cache = json.loads(self._fitted.json())
+        return self._cache
+
+    @property
+    def preferred(self) -> Optional[str]:
+        return self._doc["preferred"]
+
+    @property
+    def models(self) -> List[str]:
+        return [f["model"] for f in self._doc["fits"]]
+
+    @property
+    def params(self) -> Dict[str, Dict[str, Dict[str, Any]]]:
+        return {
             f["model"]: {
                 name: {
                     "value": p["value"],

@@ -17,6 +17,7 @@ use restitution::contact::{Material, PRESETS};
 use restitution::data::DataError;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
+mod bench;
 mod fit;
 mod kinematics;
 mod models;
@@ -201,6 +202,7 @@ fn _restitution(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(material_presets, m)?)?;
     m.add_function(wrap_pyfunction!(_panic_for_test, m)?)?;
     models::register(m)?;
+    bench::register(m)?;
     fit::register(m)?;
     walton::register(m)?;
     kinematics::register(m)?;
