@@ -1,0 +1,264 @@
+//! `kinematics`: the calls of `restitution kinematics` (src/cli/kinematics.rs): read the tracks,
+//! split and fit each collision, pool the position noise over all of them, then measure each.
+//!
+//! The two-pass pooling lives in the CLI's `run` today, not in the library; this follows the same
+//! sequence of library calls (`split_at_contact`, `analyse`, `measure_collision`) so the numbers
+//! agree, until the library exposes the whole pass as one function.
+
+use crate::{Failure, Outcome, Source, run_detached};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use restitution::data::tracks::parse_tracks;
+use restitution::experiment::Camera;
+use restitution::kinematics::{
+    Eq8Inputs, FitKind, G_STANDARD_M_S2, Measurement, TimeRule, analyse, measure_collision,
+    split_at_contact,
+};
+use restitution::models::walton::K_HOMOGENEOUS;
+
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(kinematics, m)?)?;
+    m.add("G_STANDARD_M_S2", G_STANDARD_M_S2)?;
+    m.add("K_HOMOGENEOUS", K_HOMOGENEOUS)?;
+    // The CLI's camera defaults (the paper's), for the Python signature.
+    let camera = PyDict::new(m.py());
+    camera.set_item("s_subpixels", Camera::PAPER.s_subpixels)?;
+    camera.set_item("fov_m", Camera::PAPER.fov_x_m)?;
+    camera.set_item("pixels_x", Camera::PAPER.pixels_x)?;
+    camera.set_item("subpixel_expansion", Camera::PAPER.subpixel_expansion)?;
+    m.add("PAPER_CAMERA", camera)?;
+    Ok(())
+}
+
+struct Row {
+    id: String,
+    d1_mm: f64,
+    d2_mm: f64,
+    m: Measurement,
+}
+
+struct Done {
+    rows: Vec<Row>,
+    sigma_pos_m: f64,
+    subpixel_m: f64,
+    skipped: Vec<String>,
+}
+
+/// Velocities, e, beta and psi from tracked centres, as `restitution kinematics` computes them.
+#[pyfunction]
+#[pyo3(signature = (
+    path=None, name=None, text=None, material=None, youngs_pa=None, poisson=None,
+    density_kg_m3=None, fixed_gravity=false, g_m_s2=G_STANDARD_M_S2, inertia_k=K_HOMOGENEOUS,
+    s_subpixels=Camera::PAPER.s_subpixels, subpixel_m=None, fov_m=Camera::PAPER.fov_x_m,
+    pixels_x=Camera::PAPER.pixels_x, subpixel_expansion=Camera::PAPER.subpixel_expansion,
+    strict=false
+))]
+#[allow(clippy::too_many_arguments)]
+fn kinematics<'py>(
+    py: Python<'py>,
+    path: Option<std::path::PathBuf>,
+    name: Option<String>,
+    text: Option<String>,
+    material: Option<&str>,
+    youngs_pa: Option<f64>,
+    poisson: Option<f64>,
+    density_kg_m3: Option<f64>,
+    fixed_gravity: bool,
+    g_m_s2: f64,
+    inertia_k: f64,
+    s_subpixels: f64,
+    subpixel_m: Option<f64>,
+    fov_m: f64,
+    pixels_x: u32,
+    subpixel_expansion: f64,
+    strict: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let material = crate::material(material, youngs_pa, poisson, density_kg_m3);
+    let source = Source::new(path, name, text);
+    let done = run_detached(py, move || -> Outcome<Done> {
+        let material = material?;
+        for (arg, v) in [
+            ("g_m_s2", g_m_s2),
+            ("s_subpixels", s_subpixels),
+            ("fov_m", fov_m),
+            ("subpixel_expansion", subpixel_expansion),
+            ("inertia_k", inertia_k),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(Failure::Input(format!(
+                    "{arg} = {v}: expected a number > 0"
+                )));
+            }
+        }
+        if pixels_x == 0 {
+            return Err(Failure::Input(
+                "pixels_x = 0: expected a pixel count > 0".into(),
+            ));
+        }
+        let subpixel_m = match subpixel_m {
+            Some(p) if p.is_finite() && p > 0.0 => p,
+            Some(p) => {
+                return Err(Failure::Input(format!(
+                    "subpixel_m = {p}: expected a size > 0 (m)"
+                )));
+            }
+            None => Camera {
+                fov_x_m: fov_m,
+                pixels_x,
+                subpixel_expansion,
+                ..Camera::PAPER
+            }
+            .subpixel_m(),
+        };
+        let eq8 = Eq8Inputs {
+            s_subpixels,
+            subpixel_m,
+        };
+        let kind = if fixed_gravity {
+            FitKind::FixedGravity { g_m_s2 }
+        } else {
+            FitKind::Free
+        };
+        let table = source?.table()?;
+        let tracks = parse_tracks(&table)?;
+        let place = |t: &restitution::data::tracks::CollisionTrack| {
+            format!("{}:{}: collision '{}'", table.path, t.first_line, t.id)
+        };
+        // Pass 1: fits only, to pool the residuals of every collision into one noise estimate.
+        let mut splits = Vec::new();
+        let (mut rss, mut dof) = (0.0, 0usize);
+        let mut skipped = Vec::new();
+        for t in &tracks {
+            let split = t
+                .split
+                .map(Ok)
+                .unwrap_or_else(|| split_at_contact(&t.frames, kind));
+            match split.and_then(|s| analyse(&t.frames, s, t.d1_m, t.d2_m, kind).map(|k| (s, k))) {
+                Ok((s, k)) => {
+                    rss += k.rss_m2;
+                    dof += k.dof;
+                    splits.push(Some(s));
+                }
+                Err(e) => {
+                    skipped.push(format!("{}: {e}", place(t)));
+                    splits.push(None);
+                }
+            }
+        }
+        let sigma = if dof > 0 {
+            (rss / dof as f64).sqrt()
+        } else {
+            eq8.s_subpixels * eq8.subpixel_m
+        };
+        // Pass 2: every collision measured with the pooled noise.
+        let mut rows = Vec::new();
+        for (t, split) in tracks.iter().zip(&splits) {
+            let Some(split) = *split else { continue };
+            match measure_collision(
+                &t.frames,
+                split,
+                t.d1_m,
+                t.d2_m,
+                &material,
+                inertia_k,
+                t.spins_rad_s.unwrap_or([0.0; 4]),
+                kind,
+                &eq8,
+                Some(sigma),
+            ) {
+                Ok(m) => rows.push(Row {
+                    id: t.id.clone(),
+                    d1_mm: t.d1_m * 1e3,
+                    d2_mm: t.d2_m * 1e3,
+                    m,
+                }),
+                Err(e) => skipped.push(format!("{}: {e}", place(t))),
+            }
+        }
+        if !skipped.is_empty() && (strict || rows.is_empty()) {
+            return Err(Failure::Input(skipped.swap_remove(0)));
+        }
+        Ok(Done {
+            rows,
+            sigma_pos_m: sigma,
+            subpixel_m,
+            skipped,
+        })
+    })?;
+    to_dict(py, &done)
+}
+
+fn to_dict<'py>(py: Python<'py>, done: &Done) -> PyResult<Bound<'py, PyDict>> {
+    let rows = &done.rows;
+    let col = |f: &dyn Fn(&Row) -> f64| rows.iter().map(f).collect::<Vec<f64>>();
+    let c = PyDict::new(py);
+    c.set_item(
+        "collision",
+        rows.iter().map(|r| r.id.clone()).collect::<Vec<_>>(),
+    )?;
+    c.set_item("t_c_s", col(&|r| r.m.kinematics.t_c_s))?;
+    c.set_item(
+        "time_rule",
+        rows.iter()
+            .map(|r| r.m.kinematics.time_rule.name())
+            .collect::<Vec<_>>(),
+    )?;
+    c.set_item(
+        "n_pre",
+        rows.iter()
+            .map(|r| r.m.kinematics.n_pre)
+            .collect::<Vec<_>>(),
+    )?;
+    c.set_item(
+        "n_post",
+        rows.iter()
+            .map(|r| r.m.kinematics.n_post)
+            .collect::<Vec<_>>(),
+    )?;
+    // Velocities [1 pre, 2 pre, 1 post, 2 post] and their standard errors.
+    let names = ["v1{}_m_s", "v2{}_m_s", "v1{}_post_m_s", "v2{}_post_m_s"];
+    for (i, pattern) in names.iter().enumerate() {
+        for (axis, k) in [("x", 0), ("y", 1)] {
+            let name = pattern.replace("{}", axis);
+            c.set_item(name.as_str(), col(&|r| r.m.kinematics.v_m_s[i][k]))?;
+            let err = name.replace("_m_s", "_err_m_s");
+            c.set_item(err.as_str(), col(&|r| r.m.v_err_m_s[i][k]))?;
+        }
+    }
+    c.set_item("sigma_pos_m", col(&|r| r.m.sigma_pos_m))?;
+    c.set_item("v_n_m_s", col(&|r| r.m.measured.v_n_m_s))?;
+    c.set_item("v_n_err_m_s", col(&|r| r.m.v_n_err_m_s))?;
+    c.set_item("e", col(&|r| r.m.measured.e))?;
+    c.set_item("e_err", col(&|r| r.m.e_err))?;
+    c.set_item("e_err_eq8", col(&|r| r.m.e_err_eq8))?;
+    c.set_item("eq8_dv_m_s", col(&|r| r.m.eq8_dv_m_s))?;
+    c.set_item(
+        "beta",
+        rows.iter().map(|r| r.m.measured.beta).collect::<Vec<_>>(),
+    )?;
+    c.set_item("psi", col(&|r| r.m.measured.psi))?;
+    let dv = |r: &Row| r.m.measured.com_velocity_change_m_s;
+    c.set_item(
+        "momentum_dvx_m_s",
+        rows.iter().map(|r| dv(r).map(|v| v.x)).collect::<Vec<_>>(),
+    )?;
+    c.set_item(
+        "momentum_dvy_m_s",
+        rows.iter().map(|r| dv(r).map(|v| v.y)).collect::<Vec<_>>(),
+    )?;
+    c.set_item("d1_mm", col(&|r| r.d1_mm))?;
+    c.set_item("d2_mm", col(&|r| r.d2_mm))?;
+    let d = PyDict::new(py);
+    d.set_item("columns", c)?;
+    d.set_item("sigma_pos_m", done.sigma_pos_m)?;
+    d.set_item("subpixel_m", done.subpixel_m)?;
+    d.set_item("skipped", done.skipped.clone())?;
+    d.set_item(
+        "fits_meet",
+        rows.iter()
+            .filter(|r| r.m.kinematics.time_rule != TimeRule::ContactDistance)
+            .map(|r| r.id.clone())
+            .collect::<Vec<_>>(),
+    )?;
+    Ok(d)
+}
