@@ -248,7 +248,7 @@ impl BenchReport {
         let _ = writeln!(
             s,
             "Time: wall clock per evaluation, warm, minimum over {} batches of at least {} ms; \
-             vm over the fixture's kappa in [{}, {}] (both rules), pm over its u in (1, f64::MAX].\n",
+             vm over the fixture's kappa in [{}, {}] (both rules), pm over its u in (1, 1e12].\n",
             self.config.timing().repeats,
             self.config.timing().min_batch.as_millis(),
             CHART_KAPPA_MIN,

@@ -234,7 +234,7 @@ pub fn work_precision_svg(report: &BenchReport) -> Result<String, String> {
         let y_c = (ERROR_FLOOR / 3.0, REL_ERROR_CAP * 1e4);
         let mut c = log_panel(
             &panels[2],
-            "(c) plastic: error vs time (u in (1, f64::MAX]; above 10 drawn at 10)",
+            "(c) plastic: error vs time (u in (1, 1e12]; above 10 drawn at 10)",
             "time per evaluation (ns)",
             "max relative error",
             x_c,
