@@ -233,7 +233,7 @@ pub fn lammps_files(
         for pair in &tr.pairs {
             for &v in speeds {
                 let kappa = pair.contact.kappa(*eta, v);
-                if !(kappa <= 1000.0) {
+                if kappa.is_nan() || kappa > 1000.0 {
                     return Err(format!(
                         "pair {} at {} m/s: dimensionless damping kappa = {} (eta = {} kg/(s m)); beyond 1000 the collision is overdamped (e < 1e-10): lower eta or the speed",
                         pair.label(),
