@@ -544,6 +544,50 @@ fn bad_input_gives_one_clear_line_and_no_files() {
             ],
             "--speeds 0",
         ),
+        (
+            vec![
+                "export",
+                "--engine",
+                "lammps",
+                "--material",
+                "nylon",
+                "--d-mm",
+                "1e-300",
+                "--eta",
+                "190",
+            ],
+            "--d-mm 1e-300: expected a diameter",
+        ),
+        (
+            vec![
+                "export",
+                "--engine",
+                "lammps",
+                "--material",
+                "nylon",
+                "--d-mm",
+                "5",
+                "--eta",
+                "1e300",
+            ],
+            "overdamped",
+        ),
+        (
+            vec![
+                "export",
+                "--engine",
+                "lammps",
+                "--material",
+                "nylon",
+                "--d-mm",
+                "5",
+                "--eta",
+                "190",
+                "--speeds",
+                "1e-300,10",
+            ],
+            "too wide for one run",
+        ),
     ];
     for (args, want) in cases {
         refuses(&args, want);
@@ -566,4 +610,34 @@ fn powerlaw_beyond_its_range_is_an_error_not_a_number() {
         ],
         "fitted e at speed",
     );
+}
+
+#[test]
+fn verify_without_lmp_says_so() {
+    // PATH without LAMMPS: one clear line, non-zero exit, nothing written.
+    let out = scratch("nolmp");
+    let empty = scratch("emptypath");
+    let r = Command::new(BIN)
+        .args([
+            "export",
+            "--engine",
+            "lammps",
+            "--material",
+            "nylon",
+            "--d-mm",
+            "5",
+            "--eta",
+            "190",
+            "--verify",
+            "--out",
+        ])
+        .arg(&out)
+        .env("PATH", &empty)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&r.stderr);
+    assert!(!r.status.success());
+    assert_eq!(stderr.lines().count(), 1, "{stderr}");
+    assert!(stderr.contains("lmp (LAMMPS) is not on PATH"), "{stderr}");
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 0);
 }

@@ -31,7 +31,7 @@ use restitution::contact::Material;
 use restitution::data::export::lammps::Friction;
 use restitution::data::export::plan::{self, EngineKind, LawChoice};
 use restitution::data::export::{files, read_params_json, read_walton_json, report, run};
-use restitution::data::write_all_atomic;
+use restitution::data::{fmt_num, write_all_atomic};
 use restitution::dem::law::FittedCurve;
 use restitution::dem::range::{SpeedRange, Weight};
 use restitution::dem::scene::Scene;
@@ -156,7 +156,10 @@ fn check_positive(flag: &str, x: f64) -> Result<f64, String> {
     if x.is_finite() && x > 0.0 {
         Ok(x)
     } else {
-        Err(format!("{flag} {x}: expected a finite number > 0"))
+        Err(format!(
+            "{flag} {}: expected a finite number > 0",
+            fmt_num(x)
+        ))
     }
 }
 
@@ -241,6 +244,12 @@ pub fn run(a: Args) -> CliResult {
     }
     for &d in &sizes_mm {
         check_positive("--d-mm", d)?;
+        if !(1e-3..=1e4).contains(&d) {
+            return Err(format!(
+                "--d-mm {}: expected a diameter from 0.001 to 10000 mm",
+                fmt_num(d)
+            ));
+        }
     }
     if let Some(t) = a.tolerance {
         check_positive("--tolerance", t)?;

@@ -40,9 +40,9 @@ pub fn lammps_pair_material(m1: &Material, m2: &Material, e_star_pa: f64) -> (f6
 
 /// The Young's modulus to give LAMMPS 29 Sep 2021's `fix wall/gran ... hertz/material E damp nu`
 /// for a wall contact with effective modulus `e_star_pa`. That release forms E* = E/(2 (1 - nu))
-/// for walls (not E/(2 (1 - nu^2)) as for pairs; measured here: a 6.35 mm nylon sphere at 2 m/s
-/// rebounds with e = 0.89937, which is the toolkit's e for that E* and not for the true one,
-/// 0.88342), so the modulus is scaled to give the true E*. tests/lammps.rs checks the result.
+/// for walls (not E/(2 (1 - nu^2)) as for pairs: given the material's own modulus, a 6.35 mm nylon
+/// sphere at 2 m/s rebounds with e = 0.8993 instead of 0.8833, tests/lammps.rs), so the modulus is
+/// scaled to give the true E*. tests/lammps.rs checks the result.
 pub fn lammps_wall_youngs(e_star_pa: f64, poisson: f64) -> f64 {
     2.0 * (1.0 - poisson) * e_star_pa
 }

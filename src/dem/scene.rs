@@ -30,7 +30,7 @@ pub struct ScenePair {
 }
 
 impl Scene {
-    /// Validates the diameters (1 to [`MAX_SIZES`], each > 0 and finite, no repeats).
+    /// Validates the diameters (1 to [`MAX_SIZES`], each from 1 um to 10 m, no repeats).
     pub fn new(material: Material, diameters_m: Vec<f64>, wall: bool) -> Result<Self> {
         if diameters_m.is_empty() || diameters_m.len() > MAX_SIZES {
             return Err(Error::InvalidParameter {
@@ -41,6 +41,14 @@ impl Scene {
         }
         for (k, &d) in diameters_m.iter().enumerate() {
             Sphere::new(d, material)?;
+            // Hertz contacts of DEM spheres; far outside, K, m_red and kappa over- or underflow.
+            if !(1e-6..=10.0).contains(&d) {
+                return Err(Error::InvalidParameter {
+                    name: "sphere diameter (m)",
+                    value: d,
+                    expected: "a diameter from 1e-6 to 10 m",
+                });
+            }
             if diameters_m[..k].contains(&d) {
                 return Err(Error::InvalidParameter {
                     name: "sphere diameter (m), given twice",

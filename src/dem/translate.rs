@@ -74,7 +74,12 @@ pub fn constant_e_inputs(e: f64, rule: ContactEnd) -> Result<ConstantEInputs> {
         alpha,
         lammps_cor: lammps_tsuji_cor_for_alpha(alpha),
         lammps_e_if_given_e,
-        liggghts_e: liggghts_e_for_alpha(alpha),
+        // Overlap rule: LIGGGHTS's formula is the exact e of Tsuji's dashpot (module note of
+        // [`damped`]), so e itself is the input; the force rule needs the alpha that gives e.
+        liggghts_e: match rule {
+            ContactEnd::Overlap => Some(e),
+            ContactEnd::Force => liggghts_e_for_alpha(alpha),
+        },
         liggghts_e_if_given_e,
     })
 }

@@ -227,6 +227,24 @@ pub fn lammps_files(
         f.push_str(&wall_lines);
     }
 
+    // The viscoelastic ODE gives up beyond kappa ~ 3000 (e < 1e-17 there); say so in the
+    // user's terms before it does.
+    if let LammpsLaw::Viscoelastic { eta, .. } = law {
+        for pair in &tr.pairs {
+            for &v in speeds {
+                let kappa = pair.contact.kappa(*eta, v);
+                if kappa.is_nan() || kappa > 1000.0 {
+                    return Err(format!(
+                        "pair {} at {} m/s: dimensionless damping kappa = {} (eta = {} kg/(s m)); beyond 1000 the collision is overdamped (e < 1e-10): lower eta or the speed",
+                        pair.label(),
+                        fmt_num(v),
+                        fmt_num(kappa),
+                        fmt_num(*eta)
+                    ));
+                }
+            }
+        }
+    }
     let collisions = tr
         .collisions(&law.engine_law(), speeds)
         .map_err(|e| format!("cannot predict the collisions: {e}"))?;
@@ -256,6 +274,14 @@ fn collide_input(
         .fold(0.0, f64::max);
     if !(tc_min.is_finite() && tc_min > 0.0) {
         return Err("no collision to write".into());
+    }
+    // One run steps through the longest collision at the shortest one's step: beyond a ratio of
+    // 1000 that is over 1e7 steps at the default N (hours), so the speeds (or sizes) must be
+    // split over several exports.
+    if t_sep_max / tc_min > 1000.0 {
+        return Err(format!(
+            "collide.in: contacts last from {tc_min:.3e} s to {t_sep_max:.3e} s, too wide for one run at the shortest one's step; give --speeds closer together"
+        ));
     }
     // The contact starts 10 to 11 steps after the run starts (see the gaps below); 20% beyond the
     // latest separation leaves every pair apart at the end, which collide.in prints as a gap.
