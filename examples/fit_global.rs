@@ -103,7 +103,10 @@ pub fn make_case(seed: u64) -> Case {
             1 => Some(f64::INFINITY),
             _ => Some(log_uniform(&mut rng, 1.0, 50.0)),
         };
-        pairs.push(((d * 100.0).round() / 100.0, d2.map(|x| (x * 100.0).round() / 100.0)));
+        pairs.push((
+            (d * 100.0).round() / 100.0,
+            d2.map(|x| (x * 100.0).round() / 100.0),
+        ));
     }
     let first = pair_contact(material, pairs[0].0, pairs[0].1).expect("valid pair");
     let v_mid = (v_lo * v_hi).sqrt();
@@ -307,7 +310,9 @@ fn grid_minima(values: &[f64], dims: &[usize]) -> Vec<usize> {
         if !v.is_finite() {
             continue;
         }
-        let coord: Vec<usize> = (0..dims.len()).map(|k| idx / strides[k] % dims[k]).collect();
+        let coord: Vec<usize> = (0..dims.len())
+            .map(|k| idx / strides[k] % dims[k])
+            .collect();
         let mut is_min = true;
         let n_nb = 3usize.pow(dims.len() as u32);
         for code in 0..n_nb {
@@ -383,7 +388,11 @@ pub fn reference(data: &FitData, kind: ModelKind) -> (f64, Vec<f64>) {
             let vals = g
                 .iter()
                 .map(|&t| {
-                    let row = if kind == ModelKind::Vm { vm_row(t) } else { pm_row(t) };
+                    let row = if kind == ModelKind::Vm {
+                        vm_row(t)
+                    } else {
+                        pm_row(t)
+                    };
                     chi2_of(&|i| row[i])
                 })
                 .collect();
@@ -437,7 +446,9 @@ pub fn reference(data: &FitData, kind: ModelKind) -> (f64, Vec<f64>) {
     for (idx, &v) in values.iter().enumerate() {
         if v < best {
             best = v;
-            at = (0..dims.len()).map(|k| axes[k][idx / strides_of(&dims)[k] % dims[k]]).collect();
+            at = (0..dims.len())
+                .map(|k| axes[k][idx / strides_of(&dims)[k] % dims[k]])
+                .collect();
         }
     }
     let strides: Vec<usize> = (0..dims.len())

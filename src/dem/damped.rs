@@ -195,13 +195,21 @@ pub fn rebound(
     loop {
         count += 1;
         if count > 4 * n + 200 {
-            return Err(fail(alpha, IntegrationFailure::PhaseIncomplete, "loading phase did not slow down as it must"));
+            return Err(fail(
+                alpha,
+                IntegrationFailure::PhaseIncomplete,
+                "loading phase did not slow down as it must",
+            ));
         }
         let trial = rk4(&f_s, s, &y, h);
         if !finite(&trial) || trial[0] < 0.25 {
             h *= 0.5;
             if h < 1e-300 {
-                return Err(fail(alpha, IntegrationFailure::StepSizeUnderflow, "loading step size underflow"));
+                return Err(fail(
+                    alpha,
+                    IntegrationFailure::StepSizeUnderflow,
+                    "loading step size underflow",
+                ));
             }
             continue;
         }
@@ -223,7 +231,8 @@ pub fn rebound(
         k += 1;
         if k > max_t_steps {
             return Err(fail(
-                alpha, IntegrationFailure::PhaseIncomplete,
+                alpha,
+                IntegrationFailure::PhaseIncomplete,
                 format!(
                     "no rebound within t = {} (dimensionless)",
                     h_t * max_t_steps as f64
@@ -232,7 +241,11 @@ pub fn rebound(
         }
         let next = rk4(&f_t, t, &yt, h_t);
         if !finite(&next) {
-            return Err(fail(alpha, IntegrationFailure::NonFinite, format!("non-finite state at t = {t}")));
+            return Err(fail(
+                alpha,
+                IntegrationFailure::NonFinite,
+                format!("non-finite state at t = {t}"),
+            ));
         }
         if rule == ContactEnd::Force && next[1] < 0.0 && g_t(&next) <= 0.0 {
             let (theta, y_end) = locate(|th| rk4(&f_t, t, &yt, th * h_t), |_, yy| g_t(yy));
@@ -258,7 +271,8 @@ pub fn rebound(
                 let next = rk4(&f_s, s, &y, h_c);
                 if !finite(&next) || next[0] >= 0.0 {
                     return Err(fail(
-                        alpha, IntegrationFailure::Unphysical,
+                        alpha,
+                        IntegrationFailure::Unphysical,
                         format!("unphysical unloading state at s = {s}: p = {}", next[0]),
                     ));
                 }
@@ -291,7 +305,8 @@ pub fn rebound(
     if !(e.is_finite() && e > 0.0 && e <= 1.0 + 1e-12) || (e * e - e_energy * e_energy).abs() > 1e-6
     {
         return Err(fail(
-            alpha, IntegrationFailure::Unphysical,
+            alpha,
+            IntegrationFailure::Unphysical,
             format!("unphysical result: e = {e} from the speed, {e_energy} from the energy"),
         ));
     }
@@ -366,7 +381,8 @@ pub fn alpha_for_e(e: f64, dashpot: Dashpot, rule: ContactEnd) -> Result<f64> {
     }
     if !found {
         return Err(fail(
-            f64::NAN, IntegrationFailure::Other,
+            f64::NAN,
+            IntegrationFailure::Other,
             format!("could not bracket alpha for e = {e}"),
         ));
     }
@@ -385,5 +401,9 @@ pub fn alpha_for_e(e: f64, dashpot: Dashpot, rule: ContactEnd) -> Result<f64> {
             hi = mid;
         }
     }
-    Err(fail(lo, IntegrationFailure::Other, format!("bisection for e = {e} did not converge")))
+    Err(fail(
+        lo,
+        IntegrationFailure::Other,
+        format!("bisection for e = {e} did not converge"),
+    ))
 }

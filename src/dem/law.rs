@@ -5,8 +5,8 @@
 use super::range::{SpeedRange, Weight, max_abs, max_of, mean, nodes};
 use crate::contact::Contact;
 use crate::error::{Error, Result};
-use crate::fit::scalar::brent_minimize;
 use crate::fit::models::{ModelKind, e_vm, predict_e};
+use crate::fit::scalar::brent_minimize;
 use crate::models::viscoelastic::master::KAPPA_MAX;
 use crate::models::viscoelastic::{ContactEnd, VmMethod};
 

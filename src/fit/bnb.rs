@@ -285,7 +285,11 @@ impl<L: Landscape> Bnb<L> {
         }
         let lo = [self.row(0, p0[0]), self.row(1, p0[1])];
         let hi = [self.row(0, p1[0]), self.row(1, p1[1])];
-        let ok = lo.iter().chain(&hi).enumerate().all(|(n, &r)| self.axes[n % 2].ok[r]);
+        let ok = lo
+            .iter()
+            .chain(&hi)
+            .enumerate()
+            .all(|(n, &r)| self.axes[n % 2].ok[r]);
         let target = self.target;
         let mut bound = if ok {
             self.land.bound(lo, hi, target)
@@ -416,8 +420,16 @@ impl<L: Landscape> Bnb<L> {
         let (p, v) = self.best?;
         let r = [self.row(0, p[0]), self.row(1, p[1])];
         let w = [
-            if self.axes[0].active { 1u64 << (DEPTH - 10) } else { 0 },
-            if self.axes[1].active { 1u64 << (DEPTH - 10) } else { 0 },
+            if self.axes[0].active {
+                1u64 << (DEPTH - 10)
+            } else {
+                0
+            },
+            if self.axes[1].active {
+                1u64 << (DEPTH - 10)
+            } else {
+                0
+            },
         ];
         Some(self.candidate(p, r, v, w, f64::NEG_INFINITY))
     }
@@ -456,8 +468,10 @@ impl<L: Landscape> Bnb<L> {
                     continue;
                 }
                 Split::Finest => {
-                    self.unresolved
-                        .push((cell, "a cell reached the finest dyadic resolution".to_string()));
+                    self.unresolved.push((
+                        cell,
+                        "a cell reached the finest dyadic resolution".to_string(),
+                    ));
                     continue;
                 }
             };
@@ -582,7 +596,8 @@ impl<L: Landscape> Bnb<L> {
     /// The certificate for `upper` (see [`Certificate`]).
     pub fn certificate(&self, upper: f64) -> Certificate {
         let lowest = |it: &mut dyn Iterator<Item = &Cell>| {
-            it.map(|c| c.bound.lb).fold(f64::INFINITY, |a, b| if b < a { b } else { a })
+            it.map(|c| c.bound.lb)
+                .fold(f64::INFINITY, |a, b| if b < a { b } else { a })
         };
         let coarse = lowest(
             &mut self
@@ -643,7 +658,11 @@ mod tests {
     }
     impl Landscape for TwoWells {
         fn add_row(&mut self, axis: usize, t: f64) -> Result<(), String> {
-            if axis == 0 { self.x.push(t) } else { self.y.push(t) }
+            if axis == 0 {
+                self.x.push(t)
+            } else {
+                self.y.push(t)
+            }
             Ok(())
         }
         fn node(&self, r: [usize; 2]) -> f64 {
@@ -653,7 +672,12 @@ mod tests {
             // g's minima and the kink where its two branches meet (x = 1/6, where the lower
             // envelope has a local maximum) are the only interior extremes.
             let gx = lowest(g, self.x[lo[0]], self.x[hi[0]], &[-1.0, 2.0]);
-            let gy = lowest(|y| (y - 0.3f64).powi(2), self.y[lo[1]], self.y[hi[1]], &[0.3]);
+            let gy = lowest(
+                |y| (y - 0.3f64).powi(2),
+                self.y[lo[1]],
+                self.y[hi[1]],
+                &[0.3],
+            );
             Bound {
                 lb: gx + gy,
                 loose: [self.x[hi[0]] - self.x[lo[0]], self.y[hi[1]] - self.y[lo[1]]],
@@ -688,7 +712,10 @@ mod tests {
         let c = b.candidates(0.0);
         assert!(!c.is_empty());
         for cand in &c {
-            assert!((cand.t[0] - 2.0).abs() < 0.1 && (cand.t[1] - 0.3).abs() < 0.1, "{cand:?}");
+            assert!(
+                (cand.t[0] - 2.0).abs() < 0.1 && (cand.t[1] - 0.3).abs() < 0.1,
+                "{cand:?}"
+            );
         }
         // A budget of one cell cannot certify: the cells are reported unresolved.
         let land = TwoWells {

@@ -7,8 +7,8 @@
 //! fits within 2 of the best, the one with the fewest parameters (then the lower AIC) is named,
 //! so that the data are not described with more than they support.
 
-use super::result::FitResult;
 use super::models::ModelKind;
+use super::result::FitResult;
 
 /// How the preferred model is chosen, for reports.
 pub const PREFERENCE_RULE: &str = "lowest AIC; among converged models within delta AIC <= 2 of it, the one with the fewest parameters";

@@ -71,8 +71,7 @@ pub fn fit(data: &FitData, kind: ModelKind, options: &FitOptions) -> Result<FitR
     check_size(data, kind)?;
     if let Some(s) = &options.start
         && (s.len() != k
-            || s
-                .iter()
+            || s.iter()
                 .zip(kind.params())
                 .any(|(x, p)| !(x.is_finite() && (*x > 0.0 || !p.log))))
     {
@@ -96,7 +95,10 @@ pub fn fit(data: &FitData, kind: ModelKind, options: &FitOptions) -> Result<FitR
     let mut notes = Vec::new();
     let mut converged = best.converged && global.certified;
     if !best.converged {
-        warnings.push(format!("the local polish did not converge ({})", best.reason));
+        warnings.push(format!(
+            "the local polish did not converge ({})",
+            best.reason
+        ));
     }
     let mut profiles = None;
     if options.intervals {
@@ -140,7 +142,14 @@ pub fn fit(data: &FitData, kind: ModelKind, options: &FitOptions) -> Result<FitR
     }
     let lost_intervals = options.intervals && profiles.is_none();
     let profile_evals = obj.evals.get() - fit_evals;
-    let mut r = summarise(&obj, &best, profiles.as_ref(), lost_intervals, &mut notes, &mut warnings)?;
+    let mut r = summarise(
+        &obj,
+        &best,
+        profiles.as_ref(),
+        lost_intervals,
+        &mut notes,
+        &mut warnings,
+    )?;
     if let Some(p) = &profiles {
         check_disjoint(&obj, &r, p, &near_nodes, &mut warnings);
     }

@@ -203,8 +203,14 @@ impl PowerLaw {
             y: data.obs.iter().map(|o| 1.0 - o.e).collect(),
             w_scaled: w.iter().map(|x| x / wmax).collect(),
             sens: [
-                (0..n).map(|i| w[i] * ((x1[i] - m1) * (1.0 - data.obs[i].e)).powi(2)).sum::<f64>().sqrt(),
-                (0..n).map(|i| w[i] * ((x2[i] - m2) * (1.0 - data.obs[i].e)).powi(2)).sum::<f64>().sqrt(),
+                (0..n)
+                    .map(|i| w[i] * ((x1[i] - m1) * (1.0 - data.obs[i].e)).powi(2))
+                    .sum::<f64>()
+                    .sqrt(),
+                (0..n)
+                    .map(|i| w[i] * ((x2[i] - m2) * (1.0 - data.obs[i].e)).powi(2))
+                    .sum::<f64>()
+                    .sqrt(),
             ],
             w,
             c1: x1.iter().map(|x| x - m1).collect(),

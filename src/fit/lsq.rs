@@ -253,7 +253,13 @@ pub fn levenberg_marquardt(
         reason,
     };
     if !chi2v.is_finite() {
-        return Ok(outcome(theta, chi2v, 0, false, "chi2 not finite at the start"));
+        return Ok(outcome(
+            theta,
+            chi2v,
+            0,
+            false,
+            "chi2 not finite at the start",
+        ));
     }
     if !free.iter().any(|&b| b) {
         return Ok(outcome(theta, chi2v, 0, true, "no free parameters"));
@@ -522,7 +528,10 @@ mod tests {
             ..LmOptions::default()
         };
         let r = levenberg_marquardt(&p, &[1.0, 3.0], &[true, true], &one).unwrap();
-        assert!(!r.converged && r.reason == "maximum number of iterations", "{r:?}");
+        assert!(
+            !r.converged && r.reason == "maximum number of iterations",
+            "{r:?}"
+        );
         // A non-finite start is an error; so is a model returning NaN.
         assert!(levenberg_marquardt(&p, &[f64::NAN, 3.0], &[true, true], &one).is_err());
         let mut bad = Decay {

@@ -321,8 +321,7 @@ impl<'a> Evaluator<'a> {
                 ModelKind::Min => self.e_vm(i, p[0])?.min(self.e_pm_s25(i, s25)),
                 ModelKind::Product => self.e_vm(i, p[0])? * self.e_pm_s25(i, s25),
                 ModelKind::PowerLaw => {
-                    1.0 - (p[0].ln() - p[1] * self.powerlaw_ln_d[i]
-                        + p[2] * self.powerlaw_ln_v[i])
+                    1.0 - (p[0].ln() - p[1] * self.powerlaw_ln_d[i] + p[2] * self.powerlaw_ln_v[i])
                         .exp()
                 }
             };

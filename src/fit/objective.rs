@@ -121,7 +121,12 @@ impl<'a> Objective<'a> {
     /// The observation `i` described for error messages.
     pub fn describe_point(&self, i: usize) -> String {
         let o = &self.ev.data.obs[i];
-        format!("point {} (d_mm = {}, v_n_m_s = {})", i + 1, o.d_mm, o.v_n_m_s)
+        format!(
+            "point {} (d_mm = {}, v_n_m_s = {})",
+            i + 1,
+            o.d_mm,
+            o.v_n_m_s
+        )
     }
 }
 

@@ -352,7 +352,11 @@ fn note_lines(set: &FitSet) -> Vec<String> {
 fn warning_lines(set: &FitSet) -> Vec<String> {
     set.fits
         .iter()
-        .flat_map(|f| f.warnings.iter().map(move |w| format!("{}: {w}", f.model.name())))
+        .flat_map(|f| {
+            f.warnings
+                .iter()
+                .map(move |w| format!("{}: {w}", f.model.name()))
+        })
         .collect()
 }
 

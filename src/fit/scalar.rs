@@ -163,7 +163,11 @@ pub fn profile_crossing(
     threshold: f64,
     tol: f64,
 ) -> Result<Crossing> {
-    if ![t_hat, limit, step, threshold, tol].iter().all(|x| x.is_finite()) || !(tol > 0.0) {
+    if ![t_hat, limit, step, threshold, tol]
+        .iter()
+        .all(|x| x.is_finite())
+        || !(tol > 0.0)
+    {
         return Ok(Crossing::Failed(format!(
             "non-finite search settings (t = {t_hat}, limit = {limit}, step = {step}, \
              threshold = {threshold})"
@@ -331,6 +335,9 @@ mod tests {
             Ok(if x >= 3.0 { 10.0 } else { (calls % 2) as f64 })
         };
         let c = profile_crossing(flaky, 2.0, 10.0, 0.5, 5.0, 1e-10).unwrap();
-        assert!(matches!(c, Crossing::At(x) if (x - 3.0).abs() < 1e-9), "{c:?}");
+        assert!(
+            matches!(c, Crossing::At(x) if (x - 3.0).abs() < 1e-9),
+            "{c:?}"
+        );
     }
 }

@@ -131,11 +131,11 @@ pub fn global_minimum(obj: &Objective, options: &FitOptions) -> Result<SearchOut
             };
             let active = [kind != ModelKind::Pm, kind != ModelKind::Vm];
             let land = Separable::new(obj, kind == ModelKind::Min, active);
-            let range = [
-                if active[0] { (el, eh) } else { (0.0, 0.0) },
-                (sl, sh),
+            let range = [if active[0] { (el, eh) } else { (0.0, 0.0) }, (sl, sh)];
+            let n0 = [
+                if active[0] { 24 } else { 0 },
+                if active[1] { 16 } else { 0 },
             ];
-            let n0 = [if active[0] { 24 } else { 0 }, if active[1] { 16 } else { 0 }];
             let bnb = Bnb::new(land, range, n0, limits);
             let to_theta = move |_: &Separable, _: [usize; 2], t: [f64; 2]| match kind {
                 ModelKind::Vm => vec![t[0]],
@@ -411,7 +411,9 @@ fn polish_profiles(obj: &Objective, start: Found) -> Result<Found> {
                 continue;
             }
             let n = 9;
-            let grid: Vec<f64> = (0..n).map(|i| a + (b - a) * i as f64 / (n - 1) as f64).collect();
+            let grid: Vec<f64> = (0..n)
+                .map(|i| a + (b - a) * i as f64 / (n - 1) as f64)
+                .collect();
             // From the middle outwards, each point warm-started from its neighbour.
             let mut vals = vec![f64::INFINITY; n];
             for half in [(n / 2..n).collect::<Vec<_>>(), (0..n / 2).rev().collect()] {
@@ -420,11 +422,17 @@ fn polish_profiles(obj: &Objective, start: Found) -> Result<Found> {
                     vals[i] = p(grid[i])?;
                 }
             }
-            let i = (0..n).min_by(|&x, &y| vals[x].total_cmp(&vals[y])).unwrap_or(0);
+            let i = (0..n)
+                .min_by(|&x, &y| vals[x].total_cmp(&vals[y]))
+                .unwrap_or(0);
             let (lo, hi) = (grid[i.saturating_sub(1)], grid[(i + 1).min(n - 1)]);
             centre.set(base[inner]);
             let m = scalar::brent_minimize(p, lo, hi, 1e-12)?;
-            let (u, fu) = if m.fx < vals[i] { (m.x, m.fx) } else { (grid[i], vals[i]) };
+            let (u, fu) = if m.fx < vals[i] {
+                (m.x, m.fx)
+            } else {
+                (grid[i], vals[i])
+            };
             if fu < best.chi2 {
                 let (v, at) = profile_point(obj, outer, u, centre.get())?;
                 let mut th = vec![0.0; 2];
@@ -507,27 +515,30 @@ fn run<L: Landscape>(
             ModelKind::PowerLaw => [th[1], th[2]],
         }
     };
-    let mut try_polish =
-        |bnb: &Bnb<L>, c: &Candidate, polished: &mut Vec<Found>, upper: &mut f64| -> Result<()> {
-            let near =
-                |t: [f64; 2]| (0..2).all(|k| c.bracket_lo[k] <= t[k] && t[k] <= c.bracket_hi[k]);
-            let cannot_beat = c.lb >= *upper - tau_of(*upper);
-            if cannot_beat || starts.contains(&c.t) || polished.iter().any(|f| near(axes_of(&f.theta))) {
-                return Ok(());
-            }
-            if n_polish >= MAX_POLISH {
-                skipped += 1;
-                return Ok(());
-            }
-            n_polish += 1;
-            starts.push(c.t);
-            let f = polish(&bnb.land, c)?;
-            if f.chi2 < *upper {
-                *upper = f.chi2;
-            }
-            polished.push(f);
-            Ok(())
-        };
+    let mut try_polish = |bnb: &Bnb<L>,
+                          c: &Candidate,
+                          polished: &mut Vec<Found>,
+                          upper: &mut f64|
+     -> Result<()> {
+        let near = |t: [f64; 2]| (0..2).all(|k| c.bracket_lo[k] <= t[k] && t[k] <= c.bracket_hi[k]);
+        let cannot_beat = c.lb >= *upper - tau_of(*upper);
+        if cannot_beat || starts.contains(&c.t) || polished.iter().any(|f| near(axes_of(&f.theta)))
+        {
+            return Ok(());
+        }
+        if n_polish >= MAX_POLISH {
+            skipped += 1;
+            return Ok(());
+        }
+        n_polish += 1;
+        starts.push(c.t);
+        let f = polish(&bnb.land, c)?;
+        if f.chi2 < *upper {
+            *upper = f.chi2;
+        }
+        polished.push(f);
+        Ok(())
+    };
     for c in bnb.initial_minima(upper, tau_of(upper)) {
         try_polish(&bnb, &c, &mut polished, &mut upper)?;
     }

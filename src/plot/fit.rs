@@ -3,8 +3,8 @@
 
 use crate::fit::dataset::{FitData, Group};
 use crate::fit::engine::FitSet;
-use crate::fit::result::FitResult;
 use crate::fit::models::{ModelKind, predict_e};
+use crate::fit::result::FitResult;
 use crate::models::viscoelastic::{ContactEnd, VmMethod};
 use plotters::coord::CoordTranslate;
 use plotters::coord::Shift;
