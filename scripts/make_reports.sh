@@ -36,3 +36,6 @@ $B track target/frames/shot_7 --fps 1000 --d-mm 12.7 --out reports/track > /dev/
 
 # Bench (issue 4): work-precision chart, stability map, fit accuracy, targets (timings vary by machine).
 $B bench --out reports/bench > /dev/null
+
+# Frames (issue "Frames", item 6): accuracy of the frame pipeline on rendered frames (10-15 min on 2 cores).
+cargo run --release --quiet --example frames_accuracy > /dev/null

@@ -85,7 +85,9 @@ pub struct Scene {
 }
 
 impl Scene {
-    fn position(&self, sphere: usize, t_s: f64) -> Vector2<f64> {
+    /// True centre of sphere `sphere` (0 or 1) at time `t_s` (t = 0 is the contact): ballistic
+    /// flight on the pre-collision velocity before it and the post-collision one after.
+    pub fn position(&self, sphere: usize, t_s: f64) -> Vector2<f64> {
         let r0 = if sphere == 0 { self.r1_m } else { self.r2_m };
         let v = if t_s < 0.0 {
             self.v_pre_m_s[sphere]
@@ -190,6 +192,8 @@ pub struct Simulated {
     pub split: usize,
     /// Spins measured from markers: [1 pre, 2 pre, 1 post, 2 post], rad/s.
     pub spins_measured_rad_s: [f64; 4],
+    /// The true flight, for rendering the frames (`frames::render`).
+    pub scene: Scene,
 }
 
 /// Runs the virtual experiment: draws `spec.n` collisions, resolves each with Walton's operator
@@ -287,6 +291,7 @@ pub fn simulate(
             frames,
             split,
             spins_measured_rad_s: spins,
+            scene,
         });
     }
     Ok(out)

@@ -5,6 +5,7 @@ use restitution::contact::{Material, PRESETS};
 
 pub mod bench;
 pub mod fit;
+pub mod frames_out;
 pub mod kinematics;
 pub mod predict;
 pub mod simulate;

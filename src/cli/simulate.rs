@@ -8,6 +8,7 @@
 //!     [--mu0 M] [--beta0 B] [--v-n-m-s MIN,MAX] [--incidence-deg MIN,MAX]
 //!     [--fps F] [--pixels-x N] [--pixels-y N] [--fov-m W] [--subpixel-expansion X]
 //!     [--s-subpixels S] [--frames MIN,MAX] [--spin-noise-rad-s W]
+//!     [--frames-out DIR [rendering flags: see cli/frames_out.rs]]
 //! ```
 //! Draws collisions (normal speed log-uniform, incidence uniform), resolves them with Walton's
 //! operator with e = e_model(v_n), films both spheres' ballistic flight under gravity at the frame
@@ -100,6 +101,8 @@ pub struct Args {
     /// Collisions per camera and speed in the camera study
     #[arg(long = "study-n", default_value_t = 200)]
     study_n: usize,
+    #[command(flatten)]
+    render: Box<super::frames_out::FramesArgs>,
 }
 
 fn parse_model(s: &str) -> Result<ModelKind, String> {
@@ -227,10 +230,14 @@ pub fn run(args: Args) -> CliResult {
         )
     };
     let mut rng = StdRng::seed_from_u64(args.seed);
+    if args.camera_study && args.render.wanted() {
+        return Err("--frames-out renders a simulation, not the camera study".into());
+    }
     if args.camera_study {
         return study(&args, &spec, &e_of, &mut rng);
     }
     let sims = simulate(&spec, &e_of, &mut rng).map_err(|e| e.to_string())?;
+    let frame_files = args.render.render(&sims, &spec, args.seed)?;
 
     let tracks: Vec<CollisionTrack> = sims
         .iter()
@@ -297,7 +304,7 @@ pub fn run(args: Args) -> CliResult {
     });
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("{}: cannot create: {e}", args.out.display()))?;
-    write_all_atomic(&[
+    let mut files = vec![
         (
             args.out.join("tracks.csv"),
             write_tracks(&tracks).into_bytes(),
@@ -307,8 +314,10 @@ pub fn run(args: Args) -> CliResult {
             args.out.join("truth.json"),
             (serde_json::to_string_pretty(&meta).expect("serialisable") + "\n").into_bytes(),
         ),
-    ])
-    .map_err(|e| format!("{}: cannot write: {e}", args.out.display()))?;
+    ];
+    let n_frame_files = frame_files.len();
+    files.extend(frame_files);
+    write_all_atomic(&files).map_err(|e| format!("{}: cannot write: {e}", args.out.display()))?;
     let frames: usize = sims.iter().map(|s| s.frames.len()).sum();
     println!(
         "simulated {} collisions ({} frames, position noise {} m) -> {}/tracks.csv, truth.csv, truth.json",
@@ -317,6 +326,9 @@ pub fn run(args: Args) -> CliResult {
         fmt_num(camera.sigma_m()),
         args.out.display()
     );
+    if let Some(line) = args.render.summary(n_frame_files) {
+        println!("{line}");
+    }
     Ok(())
 }
 

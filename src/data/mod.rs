@@ -8,6 +8,7 @@
 
 pub mod frames;
 pub mod images;
+pub mod png;
 pub mod tracks;
 
 use std::fmt;

@@ -44,5 +44,6 @@ pub fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
 
 pub mod fit;
 pub mod frames;
+pub mod frames_accuracy;
 pub mod kinematics;
 pub mod walton;
