@@ -119,6 +119,6 @@ pub fn blobs(img: &GrayImage) -> Vec<Blob> {
             row: sr / n as f64,
         });
     }
-    out.sort_by(|a, b| b.area.cmp(&a.area));
+    out.sort_by_key(|b| std::cmp::Reverse(b.area));
     out
 }
