@@ -30,6 +30,10 @@ $B walton fit reports/kinematics/oblique/walton_input.csv --material nylon \
     --out reports/kinematics/oblique/walton > /dev/null
 $B simulate --material nylon --camera-study --incidence-deg 0,45 --out reports/kinematics > /dev/null
 
+# From video frames: a rendered collision tracked (frames in target/, not committed).
+cargo run --release --quiet --example track_demo -- target/frames > /dev/null
+$B track target/frames/shot_7 --fps 1000 --d-mm 12.7 --out reports/track > /dev/null
+
 # Bench (issue 4): work-precision chart, stability map, fit accuracy, targets (timings vary by machine).
 $B bench --out reports/bench > /dev/null
 

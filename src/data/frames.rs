@@ -5,9 +5,9 @@
 use super::images::{list_frames, read_gray};
 use super::tracks::{CollisionTrack, write_tracks};
 use super::{DataError, fmt_num};
-use crate::frames::detect::{DetectSettings, FrameDetection, detect_frame};
+use crate::frames::detect::{DetectSettings, detect_frame};
 use crate::frames::spin::Spin;
-use crate::frames::track::{CollisionResult, FrameMeta, SphereObs};
+use crate::frames::track::{CollisionResult, FrameMeta, FrameOutcome, SphereObs};
 use rayon::prelude::*;
 use serde_json::{Value, json};
 use std::path::Path;
@@ -32,7 +32,7 @@ pub fn detect_dir(
     dir: &Path,
     settings: &DetectSettings,
     on_frame: &(dyn Fn() + Sync),
-) -> Result<Vec<(FrameMeta, Result<FrameDetection, String>)>, DataError> {
+) -> Result<Vec<FrameOutcome>, DataError> {
     let files = list_frames(dir)?;
     Ok(files
         .par_iter()
@@ -194,39 +194,46 @@ impl IntoFinite for f64 {
     }
 }
 
-fn spin_parts(
-    s: &Spin,
-) -> (
-    &'static str,
-    [Option<f64>; 3],
-    [Option<f64>; 3],
-    usize,
-    String,
-) {
+/// A spin as table cells: status, vector, errors, pairs, reason.
+struct SpinRow {
+    status: &'static str,
+    w: [Option<f64>; 3],
+    err: [Option<f64>; 3],
+    pairs: usize,
+    reason: String,
+}
+
+fn spin_parts(s: &Spin) -> SpinRow {
     match s {
         Spin::Full {
             w_rad_s,
             err_rad_s,
             pairs,
-        } => (
-            "full",
-            w_rad_s.map(Some),
-            err_rad_s.map_or([None; 3], |e| e.map(Some)),
-            *pairs,
-            String::new(),
-        ),
+        } => SpinRow {
+            status: "full",
+            w: w_rad_s.map(Some),
+            err: err_rad_s.map_or([None; 3], |e| e.map(Some)),
+            pairs: *pairs,
+            reason: String::new(),
+        },
         Spin::ZOnly {
             wz_rad_s,
             err_rad_s,
             pairs,
-        } => (
-            "z_only",
-            [None, None, Some(*wz_rad_s)],
-            [None, None, *err_rad_s],
-            *pairs,
-            "one marker per frame: assumes the spin axis is the camera axis".into(),
-        ),
-        Spin::None { reason } => ("none", [None; 3], [None; 3], 0, reason.clone()),
+        } => SpinRow {
+            status: "z_only",
+            w: [None, None, Some(*wz_rad_s)],
+            err: [None, None, *err_rad_s],
+            pairs: *pairs,
+            reason: "one marker per frame: assumes the spin axis is the camera axis".into(),
+        },
+        Spin::None { reason } => SpinRow {
+            status: "none",
+            w: [None; 3],
+            err: [None; 3],
+            pairs: 0,
+            reason: reason.clone(),
+        },
     }
 }
 
@@ -237,17 +244,17 @@ pub fn spins_csv(results: &[CollisionResult]) -> String {
     for r in results {
         for k in 0..2 {
             for (p, phase) in ["pre", "post"].iter().enumerate() {
-                let (status, w, e, pairs, reason) = spin_parts(&r.spins[k][p]);
+                let sr = spin_parts(&r.spins[k][p]);
                 let mut row = vec![
                     r.id.clone(),
                     (k + 1).to_string(),
                     phase.to_string(),
-                    status.to_string(),
+                    sr.status.to_string(),
                 ];
-                row.extend(w.iter().map(|x| opt(*x)));
-                row.extend(e.iter().map(|x| opt(*x)));
-                row.push(pairs.to_string());
-                row.push(reason);
+                row.extend(sr.w.iter().map(|x| opt(*x)));
+                row.extend(sr.err.iter().map(|x| opt(*x)));
+                row.push(sr.pairs.to_string());
+                row.push(sr.reason);
                 rows.push(row);
             }
         }
@@ -337,11 +344,11 @@ pub fn results_json(results: &[CollisionResult]) -> Value {
                 let spins: Vec<Value> = (0..2)
                     .flat_map(|k| {
                         ["pre", "post"].iter().enumerate().map(move |(ph, name)| {
-                            let (status, w, e, pairs, reason) = spin_parts(&r.spins[k][ph]);
-                            json!({"sphere": k + 1, "phase": name, "status": status,
-                                "w_rad_s": w.iter().map(|x| onum(*x)).collect::<Vec<_>>(),
-                                "w_err_rad_s": e.iter().map(|x| onum(*x)).collect::<Vec<_>>(),
-                                "pairs": pairs, "reason": reason})
+                            let sr = spin_parts(&r.spins[k][ph]);
+                            json!({"sphere": k + 1, "phase": name, "status": sr.status,
+                                "w_rad_s": sr.w.iter().map(|x| onum(*x)).collect::<Vec<_>>(),
+                                "w_err_rad_s": sr.err.iter().map(|x| onum(*x)).collect::<Vec<_>>(),
+                                "pairs": sr.pairs, "reason": sr.reason})
                         })
                     })
                     .collect();

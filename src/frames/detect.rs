@@ -123,9 +123,10 @@ pub struct DetectSettings {
 impl Default for DetectSettings {
     fn default() -> Self {
         DetectSettings {
-            // ~256 x 256: seeds need no more, and the coarse stage stays well under a
-            // millisecond even for megapixel frames.
-            max_coarse_pixels: 65_536,
+            // ~128 x 128: seeds need no more (the first edge pass searches 0.5-1.5 radii), and
+            // the coarse stage stays cheap even for megapixel frames. A sphere needs a radius of
+            // a few coarse pixels: 3 px at 192 x 239 (block 2), 24 px at 1024 x 1024 (block 8).
+            max_coarse_pixels: 16_384,
             known_radii_px: Vec::new(),
             // With 240 degrees of arc a free fit's radius is as good as a full circle's to
             // within a factor ~2 in variance (Chernov 2010, Ch. 6); shorter arcs need the radius.
@@ -252,17 +253,23 @@ pub fn detect_frame(img: &GrayImage, s: &DetectSettings) -> Result<FrameDetectio
     let n = circles.len();
     let mut last: Vec<Result<(super::circle::RobustFit, Vec<EdgePoint>), String>> =
         vec![Err("not fitted".into()); n];
+    // A sphere whose narrow-band fit lands within 0.05 px of the circle its rays were placed
+    // on has settled: a third pass would search the same band again.
+    let mut settled = vec![false; n];
     for round in 0..3 {
         let mut next = circles.clone();
         for i in 0..n {
+            if settled[i] {
+                continue;
+            }
             let c = circles[i];
             let others: Vec<Circle> = (0..n).filter(|&j| j != i).map(|j| circles[j]).collect();
             let (lo, hi, n_rays, margin) = if round == 0 {
-                let rays = ((std::f64::consts::TAU * c.r / 3.0) as usize).clamp(24, 128);
+                let rays = ((std::f64::consts::TAU * c.r / 4.0) as usize).clamp(16, 64);
                 (0.5 * c.r, 1.5 * c.r + 4.0, rays, 0.1 * c.r + 2.0)
             } else {
                 let band = (0.06 * c.r).max(3.0);
-                let rays = ((std::f64::consts::TAU * c.r) as usize).clamp(48, 360);
+                let rays = ((std::f64::consts::TAU * c.r / 1.5) as usize).clamp(48, 360);
                 (
                     (c.r - band - half_kernel).max(0.0),
                     c.r + band + half_kernel,
@@ -289,7 +296,14 @@ pub fn detect_frame(img: &GrayImage, s: &DetectSettings) -> Result<FrameDetectio
             }
             match fit {
                 Ok((rf, _)) => {
-                    next[i] = rf.fit.circle;
+                    let f = rf.fit.circle;
+                    settled[i] = round > 0
+                        && (f.cx - c.cx)
+                            .abs()
+                            .max((f.cy - c.cy).abs())
+                            .max((f.r - c.r).abs())
+                            < 0.05;
+                    next[i] = f;
                     last[i] = Ok((rf, edges));
                 }
                 Err(e) => last[i] = Err(e.to_string()),

@@ -143,6 +143,7 @@ pub fn derivative_kernel(s: &ProfileSettings) -> Vec<f64> {
 /// polarity +1 a bright-inside, dark-outside transition is positive), with subpixel
 /// interpolation. Samples outside the image shorten the ray; a maximum at either end of the
 /// usable range (no peak inside it) gives `None`, as does a maximum that is not positive.
+#[allow(clippy::too_many_arguments)]
 pub fn ray_edge(
     img: &GrayImage,
     centre: [f64; 2],
@@ -207,7 +208,7 @@ pub fn ray_edge(
         }
     }
     let (i, gmax) = best;
-    if i <= half || i + 1 >= m - half || !(gmax > 0.0) {
+    if i <= half || i + 1 >= m - half || gmax.is_nan() || gmax <= 0.0 {
         return None;
     }
     let off = subpixel_peak(g(i - 1), gmax, g(i + 1));

@@ -34,7 +34,7 @@ pub fn kabsch(a: &[Vector3<f64>], b: &[Vector3<f64>]) -> Option<Rotation3<f64>> 
     // Two pairs give rank 2: fine (the third axis follows); rank below 2 is underdetermined.
     let mut sv: Vec<f64> = svd.singular_values.iter().copied().collect();
     sv.sort_by(|x, y| y.total_cmp(x));
-    if !(sv[1] > 1e-9 * sv[0].max(1e-300)) {
+    if sv[1].is_nan() || sv[1] <= 1e-9 * sv[0].max(1e-300) {
         return None;
     }
     let v = vt.transpose();
@@ -254,7 +254,7 @@ pub fn phase_spin(frames: &[MarkerFrame], tol: f64) -> Spin {
     let mut prior = Rotation3::identity();
     for w in frames.windows(2) {
         let dt = w[1].t_s - w[0].t_s;
-        if !(dt > 0.0) {
+        if dt.is_nan() || dt <= 0.0 {
             continue;
         }
         if let Some(p) = pair_rotation(&w[0].dirs, &w[1].dirs, &prior, tol) {

@@ -24,6 +24,9 @@ pub struct FrameMeta {
     pub name: String,
 }
 
+/// A frame and what its detection gave (`Err`: the frame's problem).
+pub type FrameOutcome = (FrameMeta, Result<FrameDetection, String>);
+
 /// Settings of the assembly.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrackSettings {
@@ -150,7 +153,7 @@ fn to_obs(d: &FrameDetection, i: usize) -> SphereObs {
 /// unreadable file or no sphere). See the module doc.
 pub fn assemble(
     id: &str,
-    input: Vec<(FrameMeta, Result<FrameDetection, String>)>,
+    input: Vec<FrameOutcome>,
     s: &TrackSettings,
 ) -> Result<CollisionResult, TrackError> {
     if !(s.fps.is_finite() && s.fps > 0.0) {
