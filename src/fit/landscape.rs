@@ -381,7 +381,7 @@ impl Landscape for PowerLaw {
             if lb >= target || f1.min(f2) < target || f1.min(f2) - lb <= self.bound_tol {
                 break;
             }
-            x = x - d / h;
+            x -= d / h;
         }
         // chi2 >= 0 always; a NaN bound (overflow) is passed on for the search to report.
         Bound {

@@ -109,9 +109,7 @@ impl<'a> Objective<'a> {
     /// The chi2 scale s of the module doc.
     pub fn scale(&self, chi2: f64) -> f64 {
         let red = chi2 / self.dof() as f64;
-        if !self.ev.data.weighted {
-            red
-        } else if red > 1.0 {
+        if !self.ev.data.weighted || red > 1.0 {
             red
         } else {
             1.0

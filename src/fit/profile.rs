@@ -164,8 +164,8 @@ mod tests {
             self.x.len()
         }
         fn residuals(&self, t: &[f64], out: &mut [f64]) -> Result<()> {
-            for i in 0..self.x.len() {
-                out[i] = t[0] + t[1] * self.x[i] - self.y[i];
+            for (o, (&x, &y)) in out.iter_mut().zip(self.x.iter().zip(&self.y)) {
+                *o = t[0] + t[1] * x - y;
             }
             Ok(())
         }

@@ -166,8 +166,6 @@ pub fn to_json(ctx: &ReportContext, set: &FitSet) -> Value {
     })
 }
 
-/// Decimal exponent used to print a value (engineering style only outside [1e-3, 1e5)).
-
 /// The header of `params.csv`.
 pub const CSV_HEADER: [&str; 19] = [
     "model",

@@ -458,8 +458,6 @@ pub fn to_markdown(ctx: &ReportContext, set: &FitSet) -> String {
     s
 }
 
-/// `params.csv`: one row per model and parameter (derived ones too), full precision.
-
 #[cfg(test)]
 mod tests {
     use super::*;

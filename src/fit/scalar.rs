@@ -105,7 +105,7 @@ pub fn brent_minimize(
             let fx = st.get_best_cost();
             let reason = st.get_termination_reason();
             let converged = matches!(reason, Some(TerminationReason::SolverConverged));
-            if !(x.is_finite() && !fx.is_nan()) {
+            if !x.is_finite() || fx.is_nan() {
                 return Ok(Minimum1d {
                     x: 0.5 * (a + b),
                     fx: f64::NAN,

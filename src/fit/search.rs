@@ -274,10 +274,10 @@ fn polish_valleys(obj: &Objective, start: Found) -> Result<Found> {
         for (dir, sd) in principal_axes(obj, &best.theta)? {
             // The part of the line within reach that stays inside the box.
             let (mut amin, mut amax) = (-VALLEY_REACH * sd, VALLEY_REACH * sd);
-            for j in 0..k {
-                if dir[j] != 0.0 {
-                    let a = (obj.lower[j] - best.theta[j]) / dir[j];
-                    let b = (obj.upper[j] - best.theta[j]) / dir[j];
+            for (j, &dj) in dir.iter().enumerate().take(k) {
+                if dj != 0.0 {
+                    let a = (obj.lower[j] - best.theta[j]) / dj;
+                    let b = (obj.upper[j] - best.theta[j]) / dj;
                     amin = amin.max(a.min(b));
                     amax = amax.min(a.max(b));
                 }
@@ -473,12 +473,15 @@ const RESOLUTION_2D: f64 = 0.25;
 const RESOLUTION_SMOOTH: f64 = 1.0;
 const RESOLUTION_1D: f64 = 1.0 / 32.0;
 
+/// Maps a landscape cell (grid indices and offsets) to the model's parameters.
+type ToTheta<'a, L> = &'a dyn Fn(&L, [usize; 2], [f64; 2]) -> Vec<f64>;
+
 /// The common driver: initial minima, branch and bound, candidates, certificate.
 fn run<L: Landscape>(
     obj: &Objective,
     mut bnb: Bnb<L>,
     mut polished: Vec<Found>,
-    to_theta: &dyn Fn(&L, [usize; 2], [f64; 2]) -> Vec<f64>,
+    to_theta: ToTheta<'_, L>,
     polish: &dyn Fn(&L, &Candidate) -> Result<Found>,
 ) -> Result<SearchOutcome> {
     let tau_of = |u: f64| tolerance(obj, u);
