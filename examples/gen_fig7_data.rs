@@ -13,7 +13,7 @@
 //! plastic universal curve taking over for the small spheres at high speed (for the large ones
 //! too above ~10 m/s, where the paper had few data; the speed ranges below follow that).
 //!
-//! Error model (PHYSICS.md §5, the paper's camera): 1000 frames/s, 239 pixels across a 60 mm field
+//! Error model (docs/physics.md §5, the paper's camera): 1000 frames/s, 239 pixels across a 60 mm field
 //! of view with a 4x subpixel expansion (0.0628 mm per subpixel) and a centre accuracy of
 //! s = 2 subpixels, so s d / n_s = 0.1255 mm for every size. N frames per fit are those the
 //! sphere needs to cross half the field (30 mm) at its speed, between 2 and 12 (the paper:

@@ -1,4 +1,4 @@
-//! Materials, collision pairs and the derived Hertz contact quantities (PHYSICS.md §1).
+//! Materials, collision pairs and the derived Hertz contact quantities (docs/physics.md §1).
 //!
 //! Everything downstream is built on four numbers of a [`Contact`]: the effective modulus E*,
 //! the effective radius R~, the reduced mass m_red and the Hertz stiffness K = (4/3) E* R~^(1/2).
@@ -213,7 +213,7 @@ impl Pair {
     }
 }
 
-/// The Hertz contact of a pair (PHYSICS.md §1). SI units throughout.
+/// The Hertz contact of a pair (docs/physics.md §1). SI units throughout.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Contact {
     /// 1/E* = (1 - nu_1^2)/Y_1 + (1 - nu_2^2)/Y_2.
@@ -273,7 +273,7 @@ impl Contact {
         4.0 * eta * self.r_eff_m.sqrt()
     }
 
-    /// Brilliantov et al.'s dissipative constant A = 2C/(3K), seconds (PHYSICS.md §2).
+    /// Brilliantov et al.'s dissipative constant A = 2C/(3K), seconds (docs/physics.md §2).
     pub fn brilliantov_a_s(&self, eta: f64) -> f64 {
         2.0 * self.damping_c(eta) / (3.0 * self.hertz_k())
     }
@@ -290,7 +290,7 @@ impl Contact {
     }
 
     /// Dimensionless damping kappa = c k^(-3/5) V^(1/5) with c = C/m_red, k = K/m_red
-    /// (PHYSICS.md §2; the paper's Eq. 11 prints the powers of rho and E inverted).
+    /// (docs/physics.md §2; the paper's Eq. 11 prints the powers of rho and E inverted).
     pub fn kappa(&self, eta: f64, v_m_s: f64) -> f64 {
         let k = self.hertz_k() / self.m_red_kg;
         let c = self.damping_c(eta) / self.m_red_kg;
@@ -419,7 +419,7 @@ mod tests {
 
     #[test]
     fn paper_yield_velocity_is_6_32_m_s() {
-        // PHYSICS.md §3: Eq. (15) with the paper's nylon numbers gives 6.3233 m/s (not "about 9").
+        // docs/physics.md §3: Eq. (15) with the paper's nylon numbers gives 6.3233 m/s (not "about 9").
         let v = nylon_pair(0.0254).contact().yield_velocity_m_s(4.0e7);
         assert!((v - 6.3233).abs() < 5e-5, "{v}");
         // Size independent.

@@ -192,7 +192,7 @@ fn velocity_scatter_against_eq8_and_the_fits_covariance() {
     // The paper's momentum check: Delta v = (v1' + v2' - v1 - v2)/2 is pure measurement error.
     // Its scatter must match what the fits' covariance predicts (ratio 1), while Eq. (8) with the
     // true s predicts less: it ignores that the slope is taken at the end of the frame window
-    // (PHYSICS.md §5). 400 collisions give 800 components: the sd of a ratio estimate is ~2.5%.
+    // (docs/physics.md §5). 400 collisions give 800 components: the sd of a ratio estimate is ~2.5%.
     let sim = tmp("m");
     let kin = tmp("mk");
     run(&[

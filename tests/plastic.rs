@@ -173,7 +173,7 @@ fn yield_velocity_and_asymptote_constants() {
     let nylon = Material::preset("nylon").unwrap();
     let c = Pair::identical(Sphere::new(0.0254, nylon).unwrap()).contact();
     let p = Plastic::new(c, 4.0e7).unwrap();
-    // PHYSICS.md §3: 6.3233 m/s (mpmath: 6.32330301672985722766).
+    // docs/physics.md §3: 6.3233 m/s (mpmath: 6.32330301672985722766).
     assert!((p.yield_velocity_m_s() / 6.32330301672985722766 - 1.0).abs() < 1e-14);
     assert!((plastic::asymptote_c() / 1.18499299221237150870 - 1.0).abs() < 1e-15);
 }

@@ -166,7 +166,7 @@ proptest! {
         prop_assert!(change <= tol, "{change} > {tol}");
     }
 
-    /// KE' <= KE for 0 <= e <= 1, beta <= beta0 <= 1, and the loss equals PHYSICS.md §4's
+    /// KE' <= KE for 0 <= e <= 1, beta <= beta0 <= 1, and the loss equals docs/physics.md §4's
     /// (1/2) [m_red (1 - e^2) v_n^2 + m_t (1 - beta^2) |v_s|^2].
     #[test]
     fn kinetic_energy_never_increases(

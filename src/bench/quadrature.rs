@@ -1,7 +1,7 @@
 //! The plastic model's e by numerical quadrature of its work integrals: a deliberately generic
 //! second method to set against the closed form of [`crate::models::plastic::rebound_u`].
 //!
-//! **Solves** (PHYSICS.md §3, in units of delta_y for the overlap, P_y for the force and P_y delta_y
+//! **Solves** (docs/physics.md §3, in units of delta_y for the overlap, P_y for the force and P_y delta_y
 //! for work, so that W_y = 2/5 and the impact energy is (2/5) u^2):
 //! - Eq. (16): (2/5) u^2 = int_0^(1+q) p(xi) dxi with the loading law of Eq. (12): p = xi^(3/2)
 //!   (Hertz) for xi <= 1, p = 1 + (3/2)(xi - 1) (perfectly plastic, slope continuous) above;

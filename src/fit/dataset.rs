@@ -1,5 +1,5 @@
 //! Measured coefficients of restitution, ready for fitting: one [`Observation`] per collision,
-//! with the Hertz contact of its pair derived once (PHYSICS.md §1).
+//! with the Hertz contact of its pair derived once (docs/physics.md §1).
 //!
 //! Pure data: no file reading here (that is [`super::input`]), so that the kinematics pipeline and
 //! the benchmarks can build a [`FitData`] from numbers they already hold.
@@ -67,7 +67,7 @@ fn bad(name: &'static str, value: f64, expected: &'static str) -> Error {
     }
 }
 
-/// The contact of a pair of the given material (PHYSICS.md §1): identical spheres, unequal
+/// The contact of a pair of the given material (docs/physics.md §1): identical spheres, unequal
 /// spheres, or a sphere on a wall when `d2_mm` is infinite.
 pub fn pair_contact(material: Material, d_mm: f64, d2_mm: Option<f64>) -> Result<Contact> {
     let s1 = Sphere::new(d_mm * 1e-3, material)?;
@@ -203,7 +203,7 @@ mod tests {
         assert_eq!(g[1].indices, vec![0, 3]);
         assert_eq!(g[2].label(), "2 mm on wall");
         assert_eq!(d.diameters_mm(), vec![1.0, 2.0]);
-        // A wall's contact has R~ = R_1 (PHYSICS.md §1).
+        // A wall's contact has R~ = R_1 (docs/physics.md §1).
         assert_eq!(d.contacts[2].r_eff_m, 1e-3);
     }
 }

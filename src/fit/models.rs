@@ -1,15 +1,15 @@
 //! The five models `restitution fit` can fit, and their evaluation at each data point.
 //!
-//! - `vm`: viscoelastic (Eqs. 9-10, PHYSICS.md §2), e = f(kappa), kappa = [`Contact::kappa`]`(eta, v)`;
+//! - `vm`: viscoelastic (Eqs. 9-10, docs/physics.md §2), e = f(kappa), kappa = [`Contact::kappa`]`(eta, v)`;
 //!   parameter eta.
-//! - `pm`: plastic (Eqs. 12-18, PHYSICS.md §3), e = [`plastic::rebound_u`]`(v / V_Y(sigma_y))`;
+//! - `pm`: plastic (Eqs. 12-18, docs/physics.md §3), e = [`plastic::rebound_u`]`(v / V_Y(sigma_y))`;
 //!   parameter sigma_y.
 //! - `min`: e = min(e_vm, e_pm), a regime switch (the paper's reading of its Fig. 7: viscoelastic
 //!   at low speed, plastic once yield dissipates more); parameters eta, sigma_y.
 //! - `product`: e = e_vm e_pm, both channels dissipating in series; parameters eta, sigma_y.
 //! - `powerlaw`: the empirical 1 - e = A (d/d_ref)^(-a) (v/v_ref)^b with d_ref = 10 mm,
 //!   v_ref = 1 m/s; parameters A, a, b. The VM predicts a = 1, b = 1/5 at small dissipation; the
-//!   paper argues for a = 1/2. The size d is 4 R~ (PHYSICS.md §1), which is the diameter for
+//!   paper argues for a = 1/2. The size d is 4 R~ (docs/physics.md §1), which is the diameter for
 //!   identical spheres and makes walls and unequal pairs comparable.
 //!
 //! Every positive physical parameter (eta, sigma_y, A) is fitted as its logarithm: the data
@@ -165,7 +165,7 @@ pub fn e_vm(
     Ok(viscoelastic::restitution(contact.kappa(eta, v_m_s), rule, method)?.e)
 }
 
-/// e_pm of one contact at one speed for yield stress sigma_y (PHYSICS.md §3 closed form).
+/// e_pm of one contact at one speed for yield stress sigma_y (docs/physics.md §3 closed form).
 pub fn e_pm(contact: &Contact, v_m_s: f64, sigma_y_pa: f64) -> f64 {
     plastic::rebound_u(v_m_s / contact.yield_velocity_m_s(sigma_y_pa)).e
 }

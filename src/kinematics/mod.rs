@@ -1,4 +1,4 @@
-//! Kinematics from tracked sphere centres: Sec. III of Labous et al. (1997), PHYSICS.md §5.
+//! Kinematics from tracked sphere centres: Sec. III of Labous et al. (1997), docs/physics.md §5.
 //!
 //! **Solves**: given the centres of two spheres in a sequence of video frames before and after a
 //! collision, the velocities of both spheres just before and just after it, with uncertainties.
@@ -21,7 +21,7 @@
 //! collision's fits (a fit of 10 frames alone estimates its own noise poorly), propagated to the
 //! velocities at the collision time. Eq. (8)'s Delta v = s d/(n_s dt sqrt N) is reported next to it:
 //! it ignores that the slope is taken at the end of the window, where a quadratic fit's slope has
-//! about 1.4 times that spread (PHYSICS.md §5).
+//! about 1.4 times that spread (docs/physics.md §5).
 //!
 //! **Needs**: at least 3 frames per phase (free fits) or 2 (fixed gravity), distinct times.
 
@@ -327,7 +327,7 @@ pub fn analyse(
 
 /// Eq. (8): Delta v = s d/(n_s dt sqrt N) = s * (subpixel size)/(dt sqrt N), with s the position
 /// accuracy in subpixels, the subpixel size in metres, dt the frame interval and N the frames in
-/// the fit. Optimistic for a slope at the end of the frame window (PHYSICS.md §5).
+/// the fit. Optimistic for a slope at the end of the frame window (docs/physics.md §5).
 pub fn eq8_velocity_error_m_s(
     s_subpixels: f64,
     subpixel_m: f64,
@@ -509,7 +509,7 @@ mod tests {
 
     #[test]
     fn slope_variance_at_the_window_end_exceeds_eq8() {
-        // PHYSICS.md §5: a quadratic's slope half a frame past the end of a 10-frame window has
+        // docs/physics.md §5: a quadratic's slope half a frame past the end of a 10-frame window has
         // sd 0.4489 sigma/dt (normal equations solved by hand, independently), not Eq. (8)'s
         // sigma/(dt sqrt 10) = 0.3162 sigma/dt; at the last frame itself it is 0.4069.
         let t: Vec<f64> = (0..10).map(|k| k as f64).collect();

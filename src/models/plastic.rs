@@ -1,10 +1,10 @@
-//! Plastic model (PM): Eqs. (12)-(18) and Appendix B of Labous et al. (1997), PHYSICS.md §3.
+//! Plastic model (PM): Eqs. (12)-(18) and Appendix B of Labous et al. (1997), docs/physics.md §3.
 //!
 //! **Solves** the work balance of a Hertz loading up to yield, a linear (perfectly plastic) loading
 //! branch of slope pi sigma_y R~ (Eq. 12), and a Hertzian unloading of larger curvature fixed by
 //! continuity of P* and a* (Eq. 14), whose rebound work is W_r = 3 P*^2/(10 E* a*) (Eq. 17).
 //!
-//! **Closed form** (PHYSICS.md §3), with u = V/V_Y:
+//! **Closed form** (docs/physics.md §3), with u = V/V_Y:
 //! e = 1 for u <= 1; e = (1 + 1.5 q)/(u (1 + q)^(1/4)), q = 4 (u^2 - 1)/(sqrt(30 u^2 - 5) + 5).
 //! The curve is universal: no size or material dependence once V_Y is known (Eq. 15).
 //!
@@ -59,7 +59,7 @@ pub struct PlasticRebound {
     pub one_minus_e: f64,
 }
 
-/// e(u) and 1 - e(u) for u = V/V_Y >= 0 (PHYSICS.md §3 closed form; large-u form from
+/// e(u) and 1 - e(u) for u = V/V_Y >= 0 (docs/physics.md §3 closed form; large-u form from
 /// [`U_ASYMPTOTE`] on). Right for every finite u >= 0; +inf gives the limit e = 0; NaN gives NaN
 /// (use [`try_rebound_u`] for unvalidated input).
 pub fn rebound_u(u: f64) -> PlasticRebound {
@@ -229,7 +229,7 @@ mod tests {
 
     #[test]
     fn asymptote_constant() {
-        // PHYSICS.md §3: C = 1.18499299221237 (the paper's 1.18).
+        // docs/physics.md §3: C = 1.18499299221237 (the paper's 1.18).
         assert!((asymptote_c() - 1.18499299221237).abs() < 1e-13);
         let u = 1e12;
         assert!((e_of_u(u) * u.powf(0.25) / asymptote_c() - 1.0).abs() < 1e-5);

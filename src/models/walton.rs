@@ -1,4 +1,4 @@
-//! Walton's collision operator for frictional spheres, Eqs. (1)-(7) of the paper (PHYSICS.md §4),
+//! Walton's collision operator for frictional spheres, Eqs. (1)-(7) of the paper (docs/physics.md §4),
 //! in 3-D, for two spheres of any sizes, masses and moments of inertia, or a sphere on a flat wall.
 //!
 //! A collision is instantaneous and described by three collisional properties ([`WaltonParams`]):
@@ -15,7 +15,7 @@
 //! n = (r_1 - r_2)/|r_1 - r_2| points from sphere 2 to sphere 1; the contact velocity is
 //! v_c = v_1 - v_2 - (d_1/2 w_1 + d_2/2 w_2) x n (Eq. 3); approaching spheres have v_c . n < 0.
 //!
-//! Generalisation beyond the paper and PHYSICS.md §4 (derived here; the tests check momentum,
+//! Generalisation beyond the paper and docs/physics.md §4 (derived here; the tests check momentum,
 //! angular momentum and the energy loss for unequal K): each
 //! body carries its own inertia factor K_i = 4 I_i/(m_i d_i^2). A tangential impulse changes the
 //! contact velocity by Delta v_s = Delta P_t / m_t with the tangential effective mass
@@ -138,7 +138,7 @@ pub enum Target {
     /// A second sphere.
     Sphere(Body),
     /// A flat, immovable wall at rest. `contact_point_m` is the point of the wall that sphere 1
-    /// touches, so that r_1 - contact_point lies along the wall normal (PHYSICS.md §4).
+    /// touches, so that r_1 - contact_point lies along the wall normal (docs/physics.md §4).
     Wall { contact_point_m: Vector3<f64> },
 }
 
@@ -299,7 +299,7 @@ pub struct WaltonParams {
 
 impl WaltonParams {
     /// Validates 0 <= e <= 1, mu0 >= 0 and -1 <= beta0 <= 1: the domain on which the operator
-    /// never creates kinetic energy (PHYSICS.md §4).
+    /// never creates kinetic energy (docs/physics.md §4).
     pub fn new(e: f64, mu0: f64, beta0: f64) -> Result<Self> {
         let check = |name, v: f64, ok: bool, expected| {
             if v.is_finite() && ok {

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""High-precision reference values for the plastic model (PM), PHYSICS.md section 3.
+"""High-precision reference values for the plastic model (PM), docs/physics.md section 3.
 
 Closed form, u = V / V_Y:
     e = 1                                   for u <= 1

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """High-precision reference values for the viscoelastic (VM) master curve.
 
-Problem (PHYSICS.md section 2, dimensionless):
+Problem (docs/physics.md section 2, dimensionless):
 
     x'' = -x^(3/2) - kappa x^(1/2) x',   x(0) = 0,  x'(0) = 1,   p = x'.
 
@@ -573,7 +573,7 @@ def main():
 
 
 # --------------------------------------------------------------------------------------
-# Large kappa (docs/derivations/vm_large_kappa.md)
+# Large kappa (docs/physics.md §2.7)
 # --------------------------------------------------------------------------------------
 #
 # Both large-kappa laws come from rescalings of the same equation.  With coefficients
@@ -717,7 +717,7 @@ def large_kappa(results=None):
                 ek5 = results[ks].out["overlap"]["e"] * mpf(ks) ** 5
                 print("  kappa=%-4s e kappa^5 / A - 1 = %s" % (ks, mpmath.nstr(ek5 / A - 1, 3)))
                 # The corrections are exponentially small, ~exp(-2 lambda kappa^(5/3)) up to a
-                # prefactor (docs/derivations/vm_large_kappa.md): 3.5e-36 at kappa = 10, below the
+                # prefactor (docs/physics.md §2.7): 3.5e-36 at kappa = 10, below the
                 # dps-45 noise from kappa = 20 on.
                 bound = mpf(10) ** -(DPS_HI - 5) if mpf(ks) >= 20 else mpf(10) ** -34
                 if mpf(ks) >= 10:

@@ -1,5 +1,5 @@
 //! e(kappa) at large kappa, for both contact-end rules (docs/physics.md §2; the derivations are
-//! written out in docs/derivations/vm_large_kappa.md).
+//! written out in docs/physics.md §2.7).
 //!
 //! **Overlap rule: e = A kappa^-5.** The rescaling x = kappa^-4 X, t = kappa T maps
 //! x'' = -x^(3/2) - kappa x^(1/2) x' exactly onto the parameter-free X'' = -X^(3/2) - X^(1/2) X'

@@ -1,6 +1,6 @@
 //! Master curve: e(kappa) for each end-of-contact rule as a fast piecewise Chebyshev table.
 //!
-//! **What**: e depends on the dimensionless damping kappa alone (PHYSICS.md §2), so one function
+//! **What**: e depends on the dimensionless damping kappa alone (docs/physics.md §2), so one function
 //! per rule serves every material, size and speed. We tabulate h(s) = (1 - e)/kappa as a function
 //! of s = kappa^(1/2) on [0, `S_MAX`]: h is analytic in s down to s = 0 (h(0) = C1 = 1.1534...),
 //! including the half-integer powers of kappa that the force rule's expansion has, and

@@ -1,7 +1,7 @@
-//! Viscoelastic model (VM): Eqs. (9)-(10) of Labous, Rosato & Dave (1997), PHYSICS.md §2.
+//! Viscoelastic model (VM): Eqs. (9)-(10) of Labous, Rosato & Dave (1997), docs/physics.md §2.
 //!
 //! **Solves** m_red delta'' = -(K delta^(3/2) + C delta^(1/2) delta'), delta(0) = 0, delta'(0) = V,
-//! in the dimensionless form x'' = -x^(3/2) - kappa x^(1/2) x', x(0) = 0, x'(0) = 1 (PHYSICS.md §2:
+//! in the dimensionless form x'' = -x^(3/2) - kappa x^(1/2) x', x(0) = 0, x'(0) = 1 (docs/physics.md §2:
 //! the paper's Eq. 10 omits the sign of the force), and returns e = -x'(end) for either end-of-contact
 //! rule ([`ContactEnd`]).
 //!//! **Method** ([`ode`]): the ODE in phases, with the independent variable r = x^(1/2) where x
@@ -10,7 +10,7 @@
 //!
 //! **Every kappa >= 0** ([`restitution`] with [`VmMethod::Master`]): the master-curve table for
 //! kappa <= 10, then the large-kappa laws (docs/physics.md §2, derived in
-//! docs/derivations/vm_large_kappa.md): for the overlap rule e = A kappa^-5 exactly up to
+//! docs/physics.md §2.7): for the overlap rule e = A kappa^-5 exactly up to
 //! exponentially small terms; for the force rule a table of e kappa^(5/3) in ln kappa up to
 //! kappa = 1e7 and e = xi_m kappa^(-5/3) (1 - (2/lambda) eps ln(1/eps) + c_f eps) beyond, eps =
 //! kappa^(-5/3) ([`asymptotic`]). The small-kappa end is the table's h(0) = C1: 1 - e = C1 kappa
@@ -44,7 +44,7 @@ use crate::error::Result;
 use std::fmt;
 use std::str::FromStr;
 
-/// When the contact ends (PHYSICS.md §2).
+/// When the contact ends (docs/physics.md §2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, strum::IntoStaticStr, strum::VariantArray)]
 #[strum(serialize_all = "lowercase")]
 pub enum ContactEnd {

@@ -185,7 +185,7 @@ impl System<f64, State> for &mut Phase {
     }
 }
 
-/// e and the other collision figures for dimensionless damping `kappa` (PHYSICS.md §2).
+/// e and the other collision figures for dimensionless damping `kappa` (docs/physics.md §2).
 pub fn rebound(kappa: f64, rule: ContactEnd, settings: &OdeSettings) -> Result<Rebound> {
     solve(kappa, rule, settings, true)
 }
@@ -372,7 +372,7 @@ mod tests {
     #[test]
     fn hertz_limit_is_elastic() {
         // kappa = 0: e = 1 exactly, and the Hertz contact time and maximum overlap are known in
-        // closed form: x_max = (5/4)^(2/5), tau = 3.2180654597190430845 (PHYSICS.md §2). The
+        // closed form: x_max = (5/4)^(2/5), tau = 3.2180654597190430845 (docs/physics.md §2). The
         // trajectory is accurate to about the tolerance, so these get 10 tol.
         let tol = 10.0 * OdeSettings::DEFAULT.rtol;
         for rule in ContactEnd::ALL {

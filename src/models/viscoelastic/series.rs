@@ -1,7 +1,7 @@
 //! Cheap approximations of the viscoelastic e(kappa): the small-kappa series and Pade approximants.
 //!
 //! **What they approximate**: e(kappa) of the dimensionless collision x'' = -x^(3/2) - kappa
-//! x^(1/2) x' (PHYSICS.md §2). The ODE ([`super::restitution_ode`]) and the master-curve table
+//! x^(1/2) x' (docs/physics.md §2). The ODE ([`super::restitution_ode`]) and the master-curve table
 //! ([`super::master`]) are the model; these are cross-checks and cheap approximations whose error
 //! is stated ([`error_bound`]) and enforced on request ([`restitution_checked`]).
 //!
