@@ -15,6 +15,7 @@ use restitution::fit::models::predict_e;
 use restitution::fit::{
     FitData, FitOptions, ModelKind, Observation, ParamStatus, compare, fit, fit_all,
 };
+use restitution::fit::objective::CHI2_1DOF_95;
 use restitution::models::viscoelastic::{ContactEnd, OdeSettings, VmMethod};
 
 fn nylon() -> Material {
@@ -136,7 +137,9 @@ fn coverage(kind: ModelKind, pts: &[(f64, f64)], reps: u64) -> Vec<u32> {
         );
         let r = fit(&data, kind, &FitOptions::default()).unwrap();
         for (j, (p, t)) in r.params.iter().zip(&truth).enumerate() {
-            if let (Some(lo), Some(hi)) = p.ci95
+            // Only a converged fit's closed interval counts (a bound or a lost end does not).
+            if let (true, ParamStatus::Estimate, Some(lo), Some(hi)) =
+                (r.converged, p.status, p.ci95.0, p.ci95.1)
                 && lo <= *t
                 && *t <= hi
             {
@@ -383,4 +386,53 @@ fn information_criteria_and_preference() {
     // The same minimum as the weighted fit: all sigma were equal.
     let w = fit(&data, ModelKind::Vm, &FitOptions::default()).unwrap();
     assert!((w.params[0].best_fit / eta.best_fit - 1.0).abs() < 1e-8);
+}
+
+#[test]
+fn stderr_and_interval_use_one_chi2_scale() {
+    // Errors stated 3x too large: chi2/dof ~ 0.1. With one scale s = max(1, chi2/dof) = 1 for
+    // both, stderr equals stderr_abs and the profile interval is +-1.96 stderr in ln eta (the
+    // model is nearly linear in ln eta over so small a range). The old code scaled stderr by
+    // sqrt(chi2/dof) = 0.3 but the interval by 1, and failed this by a factor 3. Tolerance 2%:
+    // the curvature of e_vm in ln eta over +-2 stderr (measured: 0.3%).
+    let pts = design(&SIZES, 0.5, 20.0, 12);
+    let clean = synth(ModelKind::Vm, &[190.0], &pts, |_, _| 0.003, Some(31));
+    let obs: Vec<Observation> = clean
+        .obs
+        .iter()
+        .map(|o| Observation {
+            e_err: Some(0.01),
+            ..*o
+        })
+        .collect();
+    let data = FitData::new(nylon(), obs).unwrap();
+    let r = fit(&data, ModelKind::Vm, &FitOptions::default()).unwrap();
+    assert!(r.reduced_chi2 < 0.3, "{}", r.reduced_chi2);
+    assert_eq!(r.scale, 1.0);
+    let eta = r.param("eta").unwrap();
+    let (se, se_abs) = (eta.stderr.unwrap(), eta.stderr_abs.unwrap());
+    assert!((se / se_abs - 1.0).abs() < 1e-12, "{se} {se_abs}");
+    let (lo, hi) = (eta.ci95.0.unwrap(), eta.ci95.1.unwrap());
+    let half = 0.5 * (hi / lo).ln();
+    let expected = CHI2_1DOF_95.sqrt() * se / eta.value.unwrap();
+    assert!((half / expected - 1.0).abs() < 0.02, "{half} {expected}");
+    // Scatter larger than the errors: s = chi2/dof scales both alike.
+    let noisy = synth(ModelKind::Vm, &[190.0], &pts, |_, _| 0.01, Some(32));
+    let obs: Vec<Observation> = noisy
+        .obs
+        .iter()
+        .map(|o| Observation {
+            e_err: Some(0.004),
+            ..*o
+        })
+        .collect();
+    let data = FitData::new(nylon(), obs).unwrap();
+    let r = fit(&data, ModelKind::Vm, &FitOptions::default()).unwrap();
+    assert!(r.reduced_chi2 > 3.0 && (r.scale / r.reduced_chi2 - 1.0).abs() < 1e-12);
+    let eta = r.param("eta").unwrap();
+    let (se, se_abs) = (eta.stderr.unwrap(), eta.stderr_abs.unwrap());
+    assert!((se / se_abs - r.scale.sqrt()).abs() < 1e-9 * se / se_abs);
+    let half = 0.5 * (eta.ci95.1.unwrap() / eta.ci95.0.unwrap()).ln();
+    let expected = CHI2_1DOF_95.sqrt() * se / eta.value.unwrap();
+    assert!((half / expected - 1.0).abs() < 0.02, "{half} {expected}");
 }

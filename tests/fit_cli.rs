@@ -137,12 +137,20 @@ fn json_shape_is_stable() {
             "aicc",
             "bic",
             "weighted",
+            "scale",
             "ci95_delta_chi2",
             "converged",
+            "global_search",
             "evaluations",
             "profile_evaluations",
+            "warnings",
             "notes",
         ]);
+        assert_eq!(
+            keys(&f["global_search"]),
+            ["certified", "gap_chi2", "tolerance_chi2", "cells", "polishes"]
+        );
+        assert!(f["warnings"].is_array());
         assert_eq!(keys(f), expected);
         for (_, p) in f["params"].as_object().unwrap() {
             assert_eq!(
@@ -240,6 +248,9 @@ fn out_writes_all_files_and_they_agree_with_stdout() {
     );
     let csv = std::fs::read_to_string(out.join("params.csv")).unwrap();
     assert!(csv.starts_with("model,parameter,unit,status,value,stderr,stderr_abs,ci95_low"));
+    assert!(csv.lines().next().unwrap().ends_with(",converged,warnings"));
+    let md = std::fs::read_to_string(out.join("params.md")).unwrap();
+    assert!(md.contains("## Warnings"), "{md}");
     // No temporary files left behind.
     let names: Vec<String> = std::fs::read_dir(&out)
         .unwrap()

@@ -29,7 +29,8 @@ use super::models::{Evaluator, ModelKind};
 use super::objective::{CHI2_1DOF_95, Objective, check_size};
 use super::profile::{ProfileOutcome, Profiles, Side, profile_intervals};
 use super::result::{FitResult, ParamEstimate, ParamStatus, show};
-use super::search::{Found, SearchOutcome, global_minimum};
+use super::polish::Found;
+use super::search::{SearchOutcome, global_minimum};
 use crate::error::{Error, Result};
 use crate::models::viscoelastic::{ContactEnd, VmMethod};
 

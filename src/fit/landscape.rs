@@ -390,3 +390,118 @@ impl Landscape for PowerLaw {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::Material;
+    use crate::fit::dataset::{FitData, Observation};
+    use crate::fit::lsq;
+    use crate::fit::models::{Evaluator, ModelKind};
+    use crate::models::viscoelastic::{ContactEnd, VmMethod, master::KAPPA_MAX, restitution};
+
+    /// Noisy-looking data (a fixed pattern, no model behind it) on three sizes and a wall.
+    fn data() -> FitData {
+        let m = Material::preset("nylon").unwrap();
+        let obs = (0..40)
+            .map(|k| Observation {
+                d_mm: [6.35, 12.7, 25.4, 12.7][k % 4],
+                d2_mm: if k % 4 == 3 { Some(f64::INFINITY) } else { None },
+                v_n_m_s: 0.4 * 1.12f64.powi(k as i32),
+                e: 0.97 - 0.006 * k as f64 + 0.02 * ((k * 7 % 5) as f64 - 2.0) / 2.0,
+                e_err: Some(0.01 + 0.001 * (k % 3) as f64),
+            })
+            .collect();
+        FitData::new(m, obs).unwrap()
+    }
+
+    #[test]
+    fn the_monotonicity_the_bounds_rest_on_holds() {
+        // e_vm non-increasing in kappa over the master curve's range and e_pm non-decreasing in
+        // sigma_y, each to twice the accuracy allowed for (5e-14): 20000 log-spaced points.
+        for rule in [ContactEnd::Overlap, ContactEnd::Force] {
+            let mut last = f64::INFINITY;
+            for k in 0..20000 {
+                let kappa = 1e-10 * (KAPPA_MAX / 1e-10).powf(k as f64 / 19999.0);
+                let e = restitution(kappa, rule, &VmMethod::Master).unwrap().e;
+                assert!(e <= last + 1e-13, "{rule:?} kappa {kappa}: {e} > {last}");
+                last = e;
+            }
+        }
+        let mut last = f64::NEG_INFINITY;
+        for k in 0..20000 {
+            let u = 1e6f64.powf(1.0 - k as f64 / 19999.0);
+            let e = crate::models::plastic::rebound_u(u).e;
+            assert!(e >= last - 1e-13, "u {u}: {e} < {last}");
+            last = e;
+        }
+    }
+
+    /// Every bound must lie below chi2 at every point of its cell: checked on a 9 x 9 sample of
+    /// each of a set of cells, chi2 computed directly from the model (not from the rows).
+    fn check_bounds(kind: ModelKind, cells: &[([f64; 2], [f64; 2])]) {
+        let d = data();
+        let ev = Evaluator::new(&d, ContactEnd::Overlap, VmMethod::Master);
+        let obj = Objective::new(&ev, kind).unwrap();
+        for &(lo, hi) in cells {
+            let direct = |t: [f64; 2]| -> f64 {
+                let theta = match kind {
+                    ModelKind::Vm => vec![t[0]],
+                    ModelKind::Pm => vec![t[1]],
+                    ModelKind::Min | ModelKind::Product => vec![t[0], t[1]],
+                    ModelKind::PowerLaw => {
+                        vec![super::super::powerlaw::ProfiledPowerLaw::new(&obj).ln_a(&t), t[0], t[1]]
+                    }
+                };
+                lsq::chi2(&obj, &theta).unwrap()
+            };
+            let bound = if kind == ModelKind::PowerLaw {
+                let mut l = PowerLaw::new(&obj);
+                for k in 0..2 {
+                    l.add_row(k, lo[k]).unwrap();
+                    l.add_row(k, hi[k]).unwrap();
+                }
+                l.bound([0, 0], [1, 1], f64::NEG_INFINITY).lb
+            } else {
+                let active = [kind != ModelKind::Pm, kind != ModelKind::Vm];
+                let mut l = Separable::new(&obj, kind == ModelKind::Min, active);
+                for k in 0..2 {
+                    l.add_row(k, lo[k]).unwrap();
+                    l.add_row(k, hi[k]).unwrap();
+                }
+                l.bound([0, 0], [1, 1], f64::NEG_INFINITY).lb
+            };
+            let mut lowest = f64::INFINITY;
+            for i in 0..9 {
+                for j in 0..9 {
+                    let t = [
+                        lo[0] + (hi[0] - lo[0]) * i as f64 / 8.0,
+                        lo[1] + (hi[1] - lo[1]) * j as f64 / 8.0,
+                    ];
+                    lowest = lowest.min(direct(t));
+                }
+            }
+            // The power law's A is minimised inside the bound: compare with its profile.
+            assert!(bound <= lowest * (1.0 + 1e-12), "{kind} {lo:?} {hi:?}: {bound} > {lowest}");
+            assert!(bound >= 0.0 && bound.is_finite());
+        }
+    }
+
+    #[test]
+    fn bounds_are_below_chi2_everywhere_in_their_cells() {
+        let e = 190f64.ln();
+        let s = 4e7f64.ln();
+        let cells = [
+            ([e - 0.5, s - 0.3], [e + 0.5, s + 0.3]),
+            ([e - 0.01, s - 0.01], [e + 0.02, s + 0.005]),
+            ([e + 2.0, s - 2.0], [e + 4.0, s - 1.0]),
+        ];
+        for kind in [ModelKind::Vm, ModelKind::Pm, ModelKind::Min, ModelKind::Product] {
+            check_bounds(kind, &cells);
+        }
+        check_bounds(
+            ModelKind::PowerLaw,
+            &[([0.3, 0.1], [0.7, 0.5]), ([-3.0, 2.0], [1.0, 4.0]), ([0.49, 0.29], [0.51, 0.31])],
+        );
+    }
+}

@@ -231,7 +231,9 @@ pub fn profile_crossing(
                 st.get_termination_reason(),
                 Some(TerminationReason::SolverConverged)
             );
-            if let (true, Some(&x)) = (converged, st.get_best_param())
+            // The last iterate b, not argmin's "best" (the smallest |f| seen, which for a
+            // profile that is not reproducible can lie on the wrong side of the crossing).
+            if let (true, Some(&x)) = (converged, st.get_param())
                 && x.is_finite()
             {
                 return Ok(Crossing::At(x));

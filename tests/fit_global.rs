@@ -1,0 +1,201 @@
+//! Is the fit's minimum global, and does it never hang or hide a failure? Regression tests for
+//! what users found, and a seeded subset of the randomized comparison with an independent
+//! exhaustive reference (the full run, 400 data sets: `cargo run --release --example
+//! fit_global`; the data generator and the reference live in examples/fit_global/ and are used
+//! here as they are).
+
+#[path = "../examples/fit_global/cases.rs"]
+#[allow(dead_code)]
+mod cases;
+#[path = "../examples/fit_global/reference.rs"]
+#[allow(dead_code)]
+mod reference;
+
+use rand::SeedableRng;
+use rand::rngs::StdRng;
+use rand_distr::{Distribution, Normal};
+use restitution::contact::Material;
+use restitution::fit::dataset::pair_contact;
+use restitution::fit::models::predict_e;
+use restitution::fit::{FitData, FitOptions, ModelKind, Observation, fit, fit_all};
+use restitution::models::viscoelastic::{ContactEnd, VmMethod};
+
+/// The PTFE-like set users reported (Y = 5e8 Pa, nu = 0.46, rho = 2200 kg/m^3; 6.35 and 12.7 mm;
+/// 0.5-40 m/s), truth `min` with eta = 427 kg/(s m), sigma_y = 4e7 Pa, errors
+/// 2 e (0.036 m/s)/v + 0.004, seed `seed`.
+fn ptfe(seed: u64) -> FitData {
+    let m = Material::new(5e8, 0.46, 2200.0).unwrap();
+    let n01 = Normal::new(0.0, 1.0).unwrap();
+    let mut rng = StdRng::seed_from_u64(seed);
+    let mut obs = Vec::new();
+    for d in [6.35, 12.7] {
+        let c = pair_contact(m, d, None).unwrap();
+        for k in 0..30 {
+            let v = (0.5f64.ln() + (k as f64 / 29.0) * (40f64.ln() - 0.5f64.ln())).exp();
+            let e = predict_e(
+                ModelKind::Min,
+                &c,
+                v,
+                &[427.0, 4.0e7],
+                ContactEnd::Overlap,
+                &VmMethod::Master,
+            )
+            .unwrap();
+            let s = 2.0 * e * 0.036 / v + 0.004;
+            obs.push(Observation {
+                d_mm: d,
+                d2_mm: None,
+                v_n_m_s: v,
+                e: e + s * n01.sample(&mut rng),
+                e_err: Some(s),
+            });
+        }
+    }
+    FitData::new(m, obs).unwrap()
+}
+
+#[test]
+fn ptfe_set_where_the_old_search_locked_onto_the_wrong_eta_valley() {
+    // On seed 4 the previous search (profile over log sigma_y, log eta in steps of 0.5, best
+    // three profile minima; commit 1656880) returned chi2 = 69.5812 at eta = 419.5 as
+    // converged, while an independent 400 x 300 grid already reaches 69.2993 at eta = 392.6
+    // (measured with both when this test was written). The new search must be at or below the
+    // independent reference (1e-6 relative: the reference's own polish tolerance is 1e-13 in
+    // the simplex spread) and say it is certified.
+    let data = ptfe(4);
+    let r = fit(&data, ModelKind::Min, &FitOptions::default()).unwrap();
+    let reference = reference::reference_chi2(&data, ModelKind::Min);
+    assert!(
+        r.chi2 <= reference * (1.0 + 1e-6),
+        "fit {} reference {reference}",
+        r.chi2
+    );
+    assert!(r.chi2 < 69.30, "{}", r.chi2);
+    assert!(r.converged && r.global.certified, "{:?}", r.warnings);
+    let eta = r.param("eta").unwrap().best_fit;
+    assert!((eta / 392.6 - 1.0).abs() < 0.05, "{eta}");
+}
+
+#[test]
+fn tiny_errors_do_not_hang_and_overflow_is_an_error() {
+    // Four rows with e_err = 1e-80: the old profile_crossing looped forever on a NaN start.
+    // Now every model finishes, with finite numbers (chi2 ~ 1e156 is representable).
+    let m = Material::preset("nylon").unwrap();
+    let rows = [(12.7, 1.0, 0.95), (12.7, 2.0, 0.93), (6.35, 4.0, 0.90), (6.35, 8.0, 0.85)];
+    let make = |err: f64| {
+        let obs = rows
+            .iter()
+            .map(|&(d, v, e)| Observation {
+                d_mm: d,
+                d2_mm: None,
+                v_n_m_s: v,
+                e,
+                e_err: Some(err),
+            })
+            .collect();
+        FitData::new(m, obs).unwrap()
+    };
+    let set = fit_all(&make(1e-80), &ModelKind::ALL, &FitOptions::default()).unwrap();
+    for f in &set.fits {
+        assert!(f.chi2.is_finite() && f.chi2 > 1e150, "{} {}", f.model, f.chi2);
+        for p in &f.params {
+            for x in [p.value, p.stderr, p.stderr_abs, p.ci95.0, p.ci95.1]
+                .into_iter()
+                .flatten()
+            {
+                assert!(x.is_finite(), "{} {}: {x}", f.model, p.key);
+            }
+        }
+        assert!(f.converged || !f.warnings.is_empty(), "{}", f.model);
+    }
+    // e_err = 1e-200: every square overflows; an error, not a hang or a wrong number.
+    for kind in ModelKind::ALL {
+        if kind.n_params() < 4 {
+            let r = fit(&make(1e-200), kind, &FitOptions::default());
+            assert!(r.is_err(), "{kind}: {:?}", r.map(|f| f.chi2));
+        }
+    }
+}
+
+#[test]
+fn extreme_speeds_give_numbers_or_errors_never_panics() {
+    // Speeds from 1e-30 to 1e30 m/s: the search boxes stay finite (the power law's exponents are
+    // narrowed, with a warning); whatever is reported is a number or absent.
+    let m = Material::preset("nylon").unwrap();
+    let obs: Vec<Observation> = [1e-30, 1e-10, 1.0, 1e10, 1e30]
+        .iter()
+        .enumerate()
+        .map(|(i, &v)| Observation {
+            d_mm: 12.7,
+            d2_mm: None,
+            v_n_m_s: v,
+            e: 0.9 - 0.1 * i as f64,
+            e_err: Some(0.01),
+        })
+        .collect();
+    let data = FitData::new(m, obs).unwrap();
+    for kind in ModelKind::ALL {
+        match fit(&data, kind, &FitOptions::default()) {
+            Ok(f) => {
+                assert!(f.chi2.is_finite(), "{kind}");
+                for p in &f.params {
+                    assert!(p.best_fit.is_finite(), "{kind} {}", p.key);
+                    for x in [p.value, p.stderr, p.ci95.0, p.ci95.1].into_iter().flatten() {
+                        assert!(x.is_finite(), "{kind} {}: {x}", p.key);
+                    }
+                }
+                if kind == ModelKind::PowerLaw {
+                    assert!(
+                        f.warnings.iter().any(|w| w.contains("exponents")),
+                        "{:?}",
+                        f.warnings
+                    );
+                }
+            }
+            Err(e) => assert!(!e.to_string().is_empty()),
+        }
+    }
+}
+
+#[test]
+fn randomized_fits_are_at_or_below_an_independent_exhaustive_reference() {
+    // Seeds 0..16 of the full run (examples/fit_global.rs: materials, one to four sizes, walls and
+    // unequal pairs, speed ranges, noise levels, seven truths including two the fit does not
+    // offer; every model fitted). Zero fits may end more than 1e-6 relative above the
+    // reference. The full run's counts are in the README.
+    let seeds: Vec<u64> = (0..16).collect();
+    let outcomes: Vec<reference::Outcome> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..2)
+            .map(|t| {
+                let mine: Vec<u64> = seeds.iter().copied().skip(t).step_by(2).collect();
+                s.spawn(move || {
+                    mine.into_iter()
+                        .flat_map(|seed| reference::check(&cases::make_case(seed)))
+                        .collect::<Vec<_>>()
+                })
+            })
+            .collect();
+        handles
+            .into_iter()
+            .flat_map(|h| h.join().unwrap())
+            .collect()
+    });
+    assert!(outcomes.len() >= 16 * 4, "{}", outcomes.len());
+    let failures: Vec<String> = outcomes
+        .iter()
+        .filter(|o| !o.pass())
+        .map(|o| {
+            format!(
+                "seed {} {}: fit {} reference {} {:?}",
+                o.seed, o.kind, o.fit_chi2, o.ref_chi2, o.error
+            )
+        })
+        .collect();
+    eprintln!(
+        "{} fits, {} failures, {} not certified",
+        outcomes.len(),
+        failures.len(),
+        outcomes.iter().filter(|o| !o.certified).count()
+    );
+    assert!(failures.is_empty(), "{failures:#?}");
+}
