@@ -12,10 +12,10 @@ use rand_distr::{Distribution, Normal};
 use restitution::contact::Material;
 use restitution::fit::dataset::pair_contact;
 use restitution::fit::models::predict_e;
+use restitution::fit::objective::CHI2_1DOF_95;
 use restitution::fit::{
     FitData, FitOptions, ModelKind, Observation, ParamStatus, compare, fit, fit_all,
 };
-use restitution::fit::objective::CHI2_1DOF_95;
 use restitution::models::viscoelastic::{ContactEnd, OdeSettings, VmMethod};
 
 fn nylon() -> Material {

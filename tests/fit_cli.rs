@@ -148,7 +148,13 @@ fn json_shape_is_stable() {
         ]);
         assert_eq!(
             keys(&f["global_search"]),
-            ["certified", "gap_chi2", "tolerance_chi2", "cells", "polishes"]
+            [
+                "certified",
+                "gap_chi2",
+                "tolerance_chi2",
+                "cells",
+                "polishes"
+            ]
         );
         assert!(f["warnings"].is_array());
         assert_eq!(keys(f), expected);

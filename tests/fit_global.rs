@@ -81,7 +81,12 @@ fn tiny_errors_do_not_hang_and_overflow_is_an_error() {
     // Four rows with e_err = 1e-80: the old profile_crossing looped forever on a NaN start.
     // Now every model finishes, with finite numbers (chi2 ~ 1e156 is representable).
     let m = Material::preset("nylon").unwrap();
-    let rows = [(12.7, 1.0, 0.95), (12.7, 2.0, 0.93), (6.35, 4.0, 0.90), (6.35, 8.0, 0.85)];
+    let rows = [
+        (12.7, 1.0, 0.95),
+        (12.7, 2.0, 0.93),
+        (6.35, 4.0, 0.90),
+        (6.35, 8.0, 0.85),
+    ];
     let make = |err: f64| {
         let obs = rows
             .iter()
@@ -97,7 +102,12 @@ fn tiny_errors_do_not_hang_and_overflow_is_an_error() {
     };
     let set = fit_all(&make(1e-80), &ModelKind::ALL, &FitOptions::default()).unwrap();
     for f in &set.fits {
-        assert!(f.chi2.is_finite() && f.chi2 > 1e150, "{} {}", f.model, f.chi2);
+        assert!(
+            f.chi2.is_finite() && f.chi2 > 1e150,
+            "{} {}",
+            f.model,
+            f.chi2
+        );
         for p in &f.params {
             for x in [p.value, p.stderr, p.stderr_abs, p.ci95.0, p.ci95.1]
                 .into_iter()
@@ -140,7 +150,10 @@ fn extreme_speeds_give_numbers_or_errors_never_panics() {
                 assert!(f.chi2.is_finite(), "{kind}");
                 for p in &f.params {
                     assert!(p.best_fit.is_finite(), "{kind} {}", p.key);
-                    for x in [p.value, p.stderr, p.ci95.0, p.ci95.1].into_iter().flatten() {
+                    for x in [p.value, p.stderr, p.ci95.0, p.ci95.1]
+                        .into_iter()
+                        .flatten()
+                    {
                         assert!(x.is_finite(), "{kind} {}: {x}", p.key);
                     }
                 }

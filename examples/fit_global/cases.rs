@@ -70,7 +70,10 @@ pub fn make_case(seed: u64) -> Case {
             1 => Some(f64::INFINITY),
             _ => Some(log_uniform(&mut rng, 1.0, 50.0)),
         };
-        pairs.push(((d * 100.0).round() / 100.0, d2.map(|x| (x * 100.0).round() / 100.0)));
+        pairs.push((
+            (d * 100.0).round() / 100.0,
+            d2.map(|x| (x * 100.0).round() / 100.0),
+        ));
     }
     let first = pair_contact(material, pairs[0].0, pairs[0].1).expect("valid pair");
     let v_mid = (v_lo * v_hi).sqrt();

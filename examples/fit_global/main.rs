@@ -26,7 +26,6 @@
 //! **Pass**: the fit's chi2 is at most the reference's times (1 + 1e-6); a fit that returns an
 //! error fails. Reported too: fits not certified global, fits not converged.
 
-
 mod cases;
 mod reference;
 

@@ -131,7 +131,9 @@ fn grid_minima(values: &[f64], dims: &[usize]) -> Vec<usize> {
         if !v.is_finite() {
             continue;
         }
-        let coord: Vec<usize> = (0..dims.len()).map(|k| idx / strides[k] % dims[k]).collect();
+        let coord: Vec<usize> = (0..dims.len())
+            .map(|k| idx / strides[k] % dims[k])
+            .collect();
         let mut is_min = true;
         let n_nb = 3usize.pow(dims.len() as u32);
         for code in 0..n_nb {
@@ -207,7 +209,11 @@ pub fn reference(data: &FitData, kind: ModelKind) -> (f64, Vec<f64>) {
             let vals = g
                 .iter()
                 .map(|&t| {
-                    let row = if kind == ModelKind::Vm { vm_row(t) } else { pm_row(t) };
+                    let row = if kind == ModelKind::Vm {
+                        vm_row(t)
+                    } else {
+                        pm_row(t)
+                    };
                     chi2_of(&|i| row[i])
                 })
                 .collect();
@@ -261,7 +267,9 @@ pub fn reference(data: &FitData, kind: ModelKind) -> (f64, Vec<f64>) {
     for (idx, &v) in values.iter().enumerate() {
         if v < best {
             best = v;
-            at = (0..dims.len()).map(|k| axes[k][idx / strides_of(&dims)[k] % dims[k]]).collect();
+            at = (0..dims.len())
+                .map(|k| axes[k][idx / strides_of(&dims)[k] % dims[k]])
+                .collect();
         }
     }
     let strides: Vec<usize> = (0..dims.len())

@@ -275,7 +275,11 @@ impl<L: Landscape> Bnb<L> {
         }
         let lo = [self.row(0, p0[0]), self.row(1, p0[1])];
         let hi = [self.row(0, p1[0]), self.row(1, p1[1])];
-        let ok = lo.iter().chain(&hi).enumerate().all(|(n, &r)| self.axes[n % 2].ok[r]);
+        let ok = lo
+            .iter()
+            .chain(&hi)
+            .enumerate()
+            .all(|(n, &r)| self.axes[n % 2].ok[r]);
         let target = self.target;
         let mut bound = if ok {
             self.land.bound(lo, hi, target)
@@ -357,8 +361,10 @@ impl<L: Landscape> Bnb<L> {
                     continue;
                 }
                 Split::Finest => {
-                    self.unresolved
-                        .push((cell, "a cell reached the finest dyadic resolution".to_string()));
+                    self.unresolved.push((
+                        cell,
+                        "a cell reached the finest dyadic resolution".to_string(),
+                    ));
                     continue;
                 }
             };
@@ -388,9 +394,8 @@ impl<L: Landscape> Bnb<L> {
         let width = |k: usize| self.axes[k].t_at(c.p1[k]) - self.axes[k].t_at(c.p0[k]);
         let coarse = |k: usize| self.axes[k].active && width(k) > self.resolution[k];
         let l = c.bound.loose;
-        let max_over = |f: &dyn Fn(usize) -> bool| {
-            (0..2).filter(|&k| f(k)).map(|k| l[k]).fold(0.0, f64::max)
-        };
+        let max_over =
+            |f: &dyn Fn(usize) -> bool| (0..2).filter(|&k| f(k)).map(|k| l[k]).fold(0.0, f64::max);
         let lmax = max_over(&|k| coarse(k));
         let lall = max_over(&|k| self.axes[k].active);
         // Split the coarse axes that carry the most looseness (both when comparable); a coarse
@@ -429,7 +434,8 @@ impl<L: Landscape> Bnb<L> {
     /// The certificate for `upper` (see [`Certificate`]).
     pub fn certificate(&self, upper: f64) -> Certificate {
         let lowest = |it: &mut dyn Iterator<Item = &Cell>| {
-            it.map(|c| c.bound.lb).fold(f64::INFINITY, |a, b| if b < a { b } else { a })
+            it.map(|c| c.bound.lb)
+                .fold(f64::INFINITY, |a, b| if b < a { b } else { a })
         };
         let coarse = lowest(
             &mut self
@@ -492,7 +498,11 @@ mod tests {
     }
     impl Landscape for TwoWells {
         fn add_row(&mut self, axis: usize, t: f64) -> Result<(), String> {
-            if axis == 0 { self.x.push(t) } else { self.y.push(t) }
+            if axis == 0 {
+                self.x.push(t)
+            } else {
+                self.y.push(t)
+            }
             Ok(())
         }
         fn node(&self, r: [usize; 2]) -> f64 {
@@ -502,7 +512,12 @@ mod tests {
             // g's minima and the kink where its two branches meet (x = 1/6, where the lower
             // envelope has a local maximum) are the only interior extremes.
             let gx = lowest(g, self.x[lo[0]], self.x[hi[0]], &[-1.0, 2.0]);
-            let gy = lowest(|y| (y - 0.3f64).powi(2), self.y[lo[1]], self.y[hi[1]], &[0.3]);
+            let gy = lowest(
+                |y| (y - 0.3f64).powi(2),
+                self.y[lo[1]],
+                self.y[hi[1]],
+                &[0.3],
+            );
             let w = [self.x[hi[0]] - self.x[lo[0]], self.y[hi[1]] - self.y[lo[1]]];
             let slack = if self.loose { w[0] + w[1] } else { 0.0 };
             Bound {
@@ -540,7 +555,9 @@ mod tests {
         let c = b.candidates(0.0);
         assert!(!c.is_empty());
         for cand in &c {
-            let inside = (0..2).all(|k| cand.bracket_lo[k] <= [2.0, 0.3][k] && [2.0, 0.3][k] <= cand.bracket_hi[k]);
+            let inside = (0..2).all(|k| {
+                cand.bracket_lo[k] <= [2.0, 0.3][k] && [2.0, 0.3][k] <= cand.bracket_hi[k]
+            });
             assert!(inside, "{cand:?}");
         }
         // Loose (first-order) bounds need splitting: certified with the budget, unresolved and

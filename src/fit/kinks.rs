@@ -154,8 +154,9 @@ pub fn polish_profiles(obj: &Objective, start: Found) -> Result<Found> {
             let (mut u, mut fu) = (base[outer], f64::INFINITY);
             let (mut lo, mut hi) = (a, b);
             for _ in 0..3 {
-                let grid: Vec<f64> =
-                    (0..n).map(|i| a + (b - a) * i as f64 / (n - 1) as f64).collect();
+                let grid: Vec<f64> = (0..n)
+                    .map(|i| a + (b - a) * i as f64 / (n - 1) as f64)
+                    .collect();
                 // From the middle outwards, each point warm-started from its neighbour.
                 let mut vals = vec![f64::INFINITY; n];
                 for half in [(n / 2..n).collect::<Vec<_>>(), (0..n / 2).rev().collect()] {
@@ -164,7 +165,9 @@ pub fn polish_profiles(obj: &Objective, start: Found) -> Result<Found> {
                         vals[i] = p(grid[i])?;
                     }
                 }
-                let i = (0..n).min_by(|&x, &y| vals[x].total_cmp(&vals[y])).unwrap_or(0);
+                let i = (0..n)
+                    .min_by(|&x, &y| vals[x].total_cmp(&vals[y]))
+                    .unwrap_or(0);
                 if vals[i] < fu {
                     (u, fu) = (grid[i], vals[i]);
                 }
@@ -205,10 +208,10 @@ pub fn polish_profiles(obj: &Objective, start: Found) -> Result<Found> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fit::polish::polish_valleys;
     use crate::contact::Material;
     use crate::fit::dataset::{FitData, Observation};
     use crate::fit::models::{Evaluator, predict_e};
+    use crate::fit::polish::polish_valleys;
     use crate::models::viscoelastic::{ContactEnd, VmMethod};
 
     /// Noise-free data of `kind` with parameters `p` (physical) on two sizes.
@@ -245,7 +248,11 @@ mod tests {
         let f = polish_lm(&obj, &start).unwrap();
         let f = polish_valleys(&obj, f).unwrap();
         let f = polish_profiles(&obj, f).unwrap();
-        let close = f.theta.iter().zip(&truth).all(|(x, y)| (x - y).abs() < 1e-7);
+        let close = f
+            .theta
+            .iter()
+            .zip(&truth)
+            .all(|(x, y)| (x - y).abs() < 1e-7);
         assert!(close && f.chi2 < 1e-12, "{f:?}");
         // At the exact minimum no kink is near enough to be mirrored across with a positive
         // residual (every residual is zero).

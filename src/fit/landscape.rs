@@ -406,7 +406,11 @@ mod tests {
         let obs = (0..40)
             .map(|k| Observation {
                 d_mm: [6.35, 12.7, 25.4, 12.7][k % 4],
-                d2_mm: if k % 4 == 3 { Some(f64::INFINITY) } else { None },
+                d2_mm: if k % 4 == 3 {
+                    Some(f64::INFINITY)
+                } else {
+                    None
+                },
                 v_n_m_s: 0.4 * 1.12f64.powi(k as i32),
                 e: 0.97 - 0.006 * k as f64 + 0.02 * ((k * 7 % 5) as f64 - 2.0) / 2.0,
                 e_err: Some(0.01 + 0.001 * (k % 3) as f64),
@@ -450,7 +454,11 @@ mod tests {
                     ModelKind::Pm => vec![t[1]],
                     ModelKind::Min | ModelKind::Product => vec![t[0], t[1]],
                     ModelKind::PowerLaw => {
-                        vec![super::super::powerlaw::ProfiledPowerLaw::new(&obj).ln_a(&t), t[0], t[1]]
+                        vec![
+                            super::super::powerlaw::ProfiledPowerLaw::new(&obj).ln_a(&t),
+                            t[0],
+                            t[1],
+                        ]
                     }
                 };
                 lsq::chi2(&obj, &theta).unwrap()
@@ -482,7 +490,10 @@ mod tests {
                 }
             }
             // The power law's A is minimised inside the bound: compare with its profile.
-            assert!(bound <= lowest * (1.0 + 1e-12), "{kind} {lo:?} {hi:?}: {bound} > {lowest}");
+            assert!(
+                bound <= lowest * (1.0 + 1e-12),
+                "{kind} {lo:?} {hi:?}: {bound} > {lowest}"
+            );
             assert!(bound >= 0.0 && bound.is_finite());
         }
     }
@@ -496,12 +507,21 @@ mod tests {
             ([e - 0.01, s - 0.01], [e + 0.02, s + 0.005]),
             ([e + 2.0, s - 2.0], [e + 4.0, s - 1.0]),
         ];
-        for kind in [ModelKind::Vm, ModelKind::Pm, ModelKind::Min, ModelKind::Product] {
+        for kind in [
+            ModelKind::Vm,
+            ModelKind::Pm,
+            ModelKind::Min,
+            ModelKind::Product,
+        ] {
             check_bounds(kind, &cells);
         }
         check_bounds(
             ModelKind::PowerLaw,
-            &[([0.3, 0.1], [0.7, 0.5]), ([-3.0, 2.0], [1.0, 4.0]), ([0.49, 0.29], [0.51, 0.31])],
+            &[
+                ([0.3, 0.1], [0.7, 0.5]),
+                ([-3.0, 2.0], [1.0, 4.0]),
+                ([0.49, 0.29], [0.51, 0.31]),
+            ],
         );
     }
 }

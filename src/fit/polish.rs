@@ -24,7 +24,6 @@ pub struct Found {
     pub reason: String,
 }
 
-
 /// Levenberg-Marquardt over every parameter from `start`.
 pub fn polish_lm(obj: &Objective, start: &[f64]) -> Result<Found> {
     let all = vec![true; start.len()];
@@ -80,10 +79,10 @@ pub fn polish_valleys(obj: &Objective, start: Found) -> Result<Found> {
         for (dir, sd) in principal_axes(obj, &best.theta)? {
             // The part of the line within reach that stays inside the box.
             let (mut amin, mut amax) = (-VALLEY_REACH * sd, VALLEY_REACH * sd);
-            for j in 0..k {
-                if dir[j] != 0.0 {
-                    let a = (obj.lower[j] - best.theta[j]) / dir[j];
-                    let b = (obj.upper[j] - best.theta[j]) / dir[j];
+            for (j, &dj) in dir.iter().enumerate().take(k) {
+                if dj != 0.0 {
+                    let a = (obj.lower[j] - best.theta[j]) / dj;
+                    let b = (obj.upper[j] - best.theta[j]) / dj;
                     amin = amin.max(a.min(b));
                     amax = amax.min(a.max(b));
                 }
@@ -231,7 +230,10 @@ pub fn polish_newton(obj: &Objective, start: Found) -> Result<Found> {
         if g.iter().chain(hm.iter()).any(|v| !v.is_finite()) {
             break;
         }
-        let scale = (0..k).map(|i| hm[(i, i)].abs()).fold(0.0, f64::max).max(1e-300);
+        let scale = (0..k)
+            .map(|i| hm[(i, i)].abs())
+            .fold(0.0, f64::max)
+            .max(1e-300);
         let mut improved = false;
         for _ in 0..30 {
             let mut m = hm.clone();
@@ -273,7 +275,6 @@ pub const VALLEY_REACH: f64 = 4.0;
 
 /// How far (in standard errors) from a minimum a kink of `min` is looked across.
 pub const KINK_REACH: f64 = 3.0;
-
 
 #[cfg(test)]
 mod tests {

@@ -118,9 +118,9 @@ pub fn polish_powerlaw(obj: &Objective, ab: &[f64]) -> Result<Found> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fit::models::ModelKind;
     use crate::contact::Material;
     use crate::fit::dataset::{FitData, Observation};
+    use crate::fit::models::ModelKind;
     use crate::fit::models::{Evaluator, predict_e};
     use crate::models::viscoelastic::{ContactEnd, VmMethod};
 
@@ -154,7 +154,11 @@ mod tests {
         let obj = Objective::new(&ev, ModelKind::PowerLaw).unwrap();
         let truth = ModelKind::PowerLaw.to_internal(&p);
         let f = polish_powerlaw(&obj, &[1.5, -0.4]).unwrap();
-        let close = f.theta.iter().zip(&truth).all(|(x, y)| (x - y).abs() < 1e-7);
+        let close = f
+            .theta
+            .iter()
+            .zip(&truth)
+            .all(|(x, y)| (x - y).abs() < 1e-7);
         assert!(close && f.chi2 < 1e-12, "{f:?}");
         // The least-squares A at the true exponents is the true A (to rounding).
         let prof = ProfiledPowerLaw::new(&obj);

@@ -42,13 +42,13 @@
 
 use super::FitOptions;
 use super::bnb::{Bnb, Candidate, Landscape, Limits};
+use super::kinks::{axis_stderr, kink_starts, polish_profiles};
 use super::landscape::{PowerLaw, Separable};
 use super::models::ModelKind;
 use super::objective::Objective;
-use super::result::{GlobalSearch, show};
-use super::kinks::{axis_stderr, kink_starts, polish_profiles};
 use super::polish::{Found, polish_brent, polish_lm, polish_newton, polish_valleys};
 use super::powerlaw::polish_powerlaw;
+use super::result::{GlobalSearch, show};
 use crate::error::{Error, Result};
 use crate::models::viscoelastic::VmMethod;
 
@@ -124,11 +124,11 @@ pub fn global_minimum(obj: &Objective, options: &FitOptions) -> Result<SearchOut
             };
             let active = [kind != ModelKind::Pm, kind != ModelKind::Vm];
             let land = Separable::new(obj, kind == ModelKind::Min, active);
-            let range = [
-                if active[0] { (el, eh) } else { (0.0, 0.0) },
-                (sl, sh),
+            let range = [if active[0] { (el, eh) } else { (0.0, 0.0) }, (sl, sh)];
+            let n0 = [
+                if active[0] { 24 } else { 0 },
+                if active[1] { 16 } else { 0 },
             ];
-            let n0 = [if active[0] { 24 } else { 0 }, if active[1] { 16 } else { 0 }];
             let bnb = Bnb::new(land, range, n0, limits);
             let to_theta = move |_: &Separable, _: [usize; 2], t: [f64; 2]| match kind {
                 ModelKind::Vm => vec![t[0]],
@@ -171,12 +171,15 @@ const RESOLUTION_2D: f64 = 0.25;
 const RESOLUTION_SMOOTH: f64 = 1.0;
 const RESOLUTION_1D: f64 = 1.0 / 32.0;
 
+/// Maps a landscape cell (grid indices and offsets) to the model's parameters.
+type ToTheta<'a, L> = &'a dyn Fn(&L, [usize; 2], [f64; 2]) -> Vec<f64>;
+
 /// The common driver: initial minima, branch and bound, candidates, certificate.
 fn run<L: Landscape>(
     obj: &Objective,
     mut bnb: Bnb<L>,
     mut polished: Vec<Found>,
-    to_theta: &dyn Fn(&L, [usize; 2], [f64; 2]) -> Vec<f64>,
+    to_theta: ToTheta<'_, L>,
     polish: &dyn Fn(&L, &Candidate) -> Result<Found>,
 ) -> Result<SearchOutcome> {
     let tau_of = |u: f64| tolerance(obj, u);
@@ -213,27 +216,30 @@ fn run<L: Landscape>(
             ModelKind::PowerLaw => [th[1], th[2]],
         }
     };
-    let mut try_polish =
-        |bnb: &Bnb<L>, c: &Candidate, polished: &mut Vec<Found>, upper: &mut f64| -> Result<()> {
-            let near =
-                |t: [f64; 2]| (0..2).all(|k| c.bracket_lo[k] <= t[k] && t[k] <= c.bracket_hi[k]);
-            let cannot_beat = c.lb >= *upper - tau_of(*upper);
-            if cannot_beat || starts.contains(&c.t) || polished.iter().any(|f| near(axes_of(&f.theta))) {
-                return Ok(());
-            }
-            if n_polish >= MAX_POLISH {
-                skipped += 1;
-                return Ok(());
-            }
-            n_polish += 1;
-            starts.push(c.t);
-            let f = polish(&bnb.land, c)?;
-            if f.chi2 < *upper {
-                *upper = f.chi2;
-            }
-            polished.push(f);
-            Ok(())
-        };
+    let mut try_polish = |bnb: &Bnb<L>,
+                          c: &Candidate,
+                          polished: &mut Vec<Found>,
+                          upper: &mut f64|
+     -> Result<()> {
+        let near = |t: [f64; 2]| (0..2).all(|k| c.bracket_lo[k] <= t[k] && t[k] <= c.bracket_hi[k]);
+        let cannot_beat = c.lb >= *upper - tau_of(*upper);
+        if cannot_beat || starts.contains(&c.t) || polished.iter().any(|f| near(axes_of(&f.theta)))
+        {
+            return Ok(());
+        }
+        if n_polish >= MAX_POLISH {
+            skipped += 1;
+            return Ok(());
+        }
+        n_polish += 1;
+        starts.push(c.t);
+        let f = polish(&bnb.land, c)?;
+        if f.chi2 < *upper {
+            *upper = f.chi2;
+        }
+        polished.push(f);
+        Ok(())
+    };
     for c in bnb.initial_minima(upper, tau_of(upper)) {
         try_polish(&bnb, &c, &mut polished, &mut upper)?;
     }
@@ -290,7 +296,12 @@ fn run<L: Landscape>(
         // coordinates: far below any standard error, far above the polishes' tolerance).
         let mut unique: Vec<Found> = Vec::new();
         for f in close {
-            let same = |g: &Found| f.theta.iter().zip(&g.theta).all(|(a, b)| (a - b).abs() < 1e-7);
+            let same = |g: &Found| {
+                f.theta
+                    .iter()
+                    .zip(&g.theta)
+                    .all(|(a, b)| (a - b).abs() < 1e-7)
+            };
             if !unique.iter().any(same) {
                 unique.push(f);
             }

@@ -102,8 +102,16 @@ impl<L: Landscape> Bnb<L> {
         let (p, v) = self.best?;
         let r = [self.row(0, p[0]), self.row(1, p[1])];
         let w = [
-            if self.axes[0].active { 1u64 << (DEPTH - 10) } else { 0 },
-            if self.axes[1].active { 1u64 << (DEPTH - 10) } else { 0 },
+            if self.axes[0].active {
+                1u64 << (DEPTH - 10)
+            } else {
+                0
+            },
+            if self.axes[1].active {
+                1u64 << (DEPTH - 10)
+            } else {
+                0
+            },
         ];
         Some(self.candidate(p, r, v, w, f64::NEG_INFINITY))
     }
@@ -163,5 +171,4 @@ impl<L: Landscape> Bnb<L> {
         out.sort_by(|a, b| a.chi2.total_cmp(&b.chi2));
         out
     }
-
 }
