@@ -168,6 +168,93 @@ impl FitData {
     }
 }
 
+/// The data with every set of rows that share a pair geometry and a speed merged into one point
+/// (see [`FitData::merge_repeats`]).
+#[derive(Debug, Clone)]
+pub struct Merged {
+    /// One observation per distinct (d, d2, v_n): e is the rows' weighted mean and e_err
+    /// 1/sqrt(sum of weights); `weighted` is that of the rows.
+    pub data: FitData,
+    /// Rows before merging.
+    pub rows: usize,
+    /// sum_i w_i (e_i - e_mean)^2 over the rows, the part of chi2 no parameter can change.
+    pub chi2_offset: f64,
+    /// The merged point of each row.
+    pub point_of_row: Vec<usize>,
+    /// The first row of each merged point (to name it in messages).
+    pub first_row: Vec<usize>,
+}
+
+impl FitData {
+    /// Merges rows that share a pair geometry and a speed, or `None` when no two rows do (or when
+    /// the merged weights would not be finite: the rows are then fitted as they are).
+    ///
+    /// Exact, because sigma does not depend on the parameters: for rows i of one point, with
+    /// w_i = 1/sigma_i^2, W = sum w_i and the weighted mean m,
+    /// sum w_i (e_i - f)^2 = W (m - f)^2 + sum w_i (e_i - m)^2, so chi2 over the rows is chi2
+    /// over the merged points (sigma = 1/sqrt(W)) plus a constant: the same minimum, Jacobian
+    /// products, profiles and differences of chi2. Repeated launches at one nominal speed make
+    /// such data; so do files of repeated rows, which would otherwise cost the fit their count.
+    pub fn merge_repeats(&self) -> Option<Merged> {
+        let key = |o: &Observation| (o.d_mm.to_bits(), o.d2_mm.map(f64::to_bits), o.v_n_m_s.to_bits());
+        let mut index: std::collections::HashMap<_, usize> = std::collections::HashMap::new();
+        let mut point_of_row = Vec::with_capacity(self.obs.len());
+        let mut first_row = Vec::new();
+        for (i, o) in self.obs.iter().enumerate() {
+            let next = first_row.len();
+            let p = *index.entry(key(o)).or_insert(next);
+            if p == next {
+                first_row.push(i);
+            }
+            point_of_row.push(p);
+        }
+        let m = first_row.len();
+        if m == self.obs.len() {
+            return None;
+        }
+        let mut w_sum = vec![0.0; m];
+        let mut we_sum = vec![0.0; m];
+        for (i, &p) in point_of_row.iter().enumerate() {
+            let w = self.sigma(i).powi(-2);
+            w_sum[p] += w;
+            we_sum[p] += w * self.obs[i].e;
+        }
+        let mean: Vec<f64> = (0..m).map(|p| we_sum[p] / w_sum[p]).collect();
+        let mut chi2_offset = 0.0;
+        for (i, &p) in point_of_row.iter().enumerate() {
+            chi2_offset += self.sigma(i).powi(-2) * (self.obs[i].e - mean[p]).powi(2);
+        }
+        let sigma: Vec<f64> = w_sum.iter().map(|w| w.sqrt().recip()).collect();
+        let finite = |x: &f64| x.is_finite();
+        if !(mean.iter().all(finite)
+            && sigma.iter().all(|s| s.is_finite() && *s > 0.0)
+            && chi2_offset.is_finite())
+        {
+            return None;
+        }
+        let obs = (0..m)
+            .map(|p| Observation {
+                e: mean[p],
+                e_err: Some(sigma[p]),
+                ..self.obs[first_row[p]]
+            })
+            .collect();
+        let contacts = first_row.iter().map(|&i| self.contacts[i]).collect();
+        Some(Merged {
+            data: FitData {
+                material: self.material,
+                obs,
+                contacts,
+                weighted: self.weighted,
+            },
+            rows: self.obs.len(),
+            chi2_offset,
+            point_of_row,
+            first_row,
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -23,7 +23,7 @@
 //! the reported minimum itself is in doubt.
 
 use super::compare::{Comparison, compare};
-use super::dataset::{FitData, pair_contact};
+use super::dataset::{FitData, Merged, pair_contact};
 use super::lsq::{self, LmOptions};
 use super::models::{Evaluator, ModelKind};
 use super::objective::{CHI2_1DOF_95, Objective, check_size};
@@ -82,8 +82,14 @@ pub fn fit(data: &FitData, kind: ModelKind, options: &FitOptions) -> Result<FitR
             expected: "one finite value per model parameter (positive where fitted as a log)",
         });
     }
-    let ev = Evaluator::new(data, options.rule, options.vm_method);
-    let obj = Objective::new(&ev, kind)?;
+    // Repeated (d, d2, v) rows cost the search their count but change chi2 only by a constant.
+    let merged = data.merge_repeats();
+    let points = merged.as_ref().map_or(data, |m| &m.data);
+    let ev = Evaluator::new(points, options.rule, options.vm_method);
+    let mut obj = Objective::new(&ev, kind)?;
+    if let Some(m) = &merged {
+        obj = obj.with_merged(m);
+    }
     let search = global_minimum(&obj, options)?;
     let fit_evals = obj.evals.get();
     let SearchOutcome {
@@ -117,8 +123,8 @@ pub fn fit(data: &FitData, kind: ModelKind, options: &FitOptions) -> Result<FitR
                     let again = lsq::levenberg_marquardt(&obj, &t, &all, &LmOptions::default())?;
                     warnings.push(format!(
                         "a profile found chi2 {} below the minimum {}; refitted from it",
-                        show(again.chi2),
-                        show(best.chi2)
+                        show(again.chi2 + obj.chi2_offset),
+                        show(best.chi2 + obj.chi2_offset)
                     ));
                     if again.chi2 < best.chi2 {
                         best = Found {
@@ -145,6 +151,8 @@ pub fn fit(data: &FitData, kind: ModelKind, options: &FitOptions) -> Result<FitR
     let profile_evals = obj.evals.get() - fit_evals;
     let mut r = summarise(
         &obj,
+        data,
+        merged.as_ref(),
         &best,
         profiles.as_ref(),
         lost_intervals,
@@ -180,7 +188,8 @@ fn check_disjoint(
     nodes: &[(Vec<f64>, f64)],
     warnings: &mut Vec<String>,
 ) {
-    let threshold = r.chi2 + p.delta;
+    // The nodes' chi2 is that of the points (see Objective::chi2_offset).
+    let threshold = r.chi2 - obj.chi2_offset + p.delta;
     for (j, spec) in obj.kind.params().iter().enumerate() {
         let lo = match p.sides[j][0] {
             Side::At(t) => t,
@@ -201,7 +210,7 @@ fn check_disjoint(
                 "the 95% region of {} has a part outside the interval: chi2 = {} (within the \
                  threshold {}) at {} = {}",
                 spec.key,
-                crate::data::fmt_num(*c),
+                crate::data::fmt_num(*c + obj.chi2_offset),
                 crate::data::fmt_num(threshold),
                 spec.key,
                 crate::data::fmt_num(v)
@@ -210,8 +219,11 @@ fn check_disjoint(
     }
 }
 
+/// The result at `best`, for the rows of `data` (the objective may see them merged).
 fn summarise(
     obj: &Objective,
+    data: &FitData,
+    merged: Option<&Merged>,
     best: &Found,
     profiles: Option<&Profiles>,
     lost_intervals: bool,
@@ -219,11 +231,11 @@ fn summarise(
     warnings: &mut Vec<String>,
 ) -> Result<FitResult> {
     let kind = obj.kind;
-    let data = obj.ev.data;
     let n = data.len();
     let k = kind.n_params();
     let theta = best.theta.clone();
-    let chi2 = lsq::chi2(obj, &theta)?;
+    let chi2_points = lsq::chi2(obj, &theta)?;
+    let chi2 = chi2_points + obj.chi2_offset;
     if !chi2.is_finite() {
         return Err(Error::InvalidParameter {
             name: "chi2 at the best fit (the squares overflow: e_err too small?)",
@@ -235,7 +247,7 @@ fn summarise(
     let cov = &full_cov.matrix;
     let dof = n - k;
     let reduced = chi2 / dof as f64;
-    let scale = obj.scale(chi2);
+    let scale = obj.scale(chi2_points);
     let phys = kind.to_physical(&theta);
     let specs = kind.params();
     let mut params = Vec::with_capacity(k);
@@ -330,11 +342,23 @@ fn summarise(
                 .collect()
         })
         .collect();
-    let mut predicted = vec![0.0; n];
-    obj.ev.predict(kind, &phys, &mut predicted)?;
+    let mut at_points = vec![0.0; obj.ev.len()];
+    obj.ev.predict(kind, &phys, &mut at_points)?;
+    let predicted: Vec<f64> = match merged {
+        Some(m) => m.point_of_row.iter().map(|&p| at_points[p]).collect(),
+        None => at_points,
+    };
     let normalized_residuals = (0..n)
-        .map(|i| (data.obs[i].e - predicted[i]) * obj.inv_sigma[i])
+        .map(|i| (data.obs[i].e - predicted[i]) / data.sigma(i))
         .collect();
+    if let Some(m) = merged {
+        notes.push(format!(
+            "{} rows share {} distinct (d, d2, v_n) points: fitted as those points with their              weighted mean e (exact: chi2 differs by the constant {})",
+            n,
+            m.data.len(),
+            crate::data::fmt_num(m.chi2_offset)
+        ));
+    }
     let (kf, nf) = (k as f64, n as f64);
     let base = if data.weighted {
         chi2

@@ -18,7 +18,7 @@
 //! Delta chi2 = 3.84 s, so for a model linear in its parameters the interval is exactly
 //! value +- 1.96 stderr.
 
-use super::dataset::FitData;
+use super::dataset::{FitData, Merged};
 use super::lsq::Residuals;
 use super::models::{Evaluator, ModelKind, POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S, powerlaw_d_mm};
 use crate::error::{Error, Result};
@@ -45,6 +45,14 @@ pub struct Objective<'a> {
     pub e_accuracy: f64,
     /// Things the set-up changed and a user should know (a narrowed box).
     pub warnings: Vec<String>,
+    /// Rows of the data as given: more than the evaluator's points when repeats were merged
+    /// ([`FitData::merge_repeats`]); the degrees of freedom count rows.
+    pub rows: usize,
+    /// chi2 of the rows minus chi2 of the points (0 unless repeats were merged): residuals and
+    /// [`super::lsq::chi2`] see the points, [`Objective::scale`] and the reports the rows.
+    pub chi2_offset: f64,
+    /// The first row of each point, when repeats were merged (for messages).
+    first_row: Option<Vec<usize>>,
 }
 
 impl Residuals for Objective<'_> {
@@ -98,17 +106,29 @@ impl<'a> Objective<'a> {
             inv_sigma,
             e_accuracy: model_accuracy(&ev.method),
             warnings,
+            rows: data.len(),
+            chi2_offset: 0.0,
+            first_row: None,
         })
     }
 
-    /// Degrees of freedom, n - k (positive: the engine refuses n <= k).
-    pub fn dof(&self) -> usize {
-        self.ev.len() - self.kind.n_params()
+    /// The problem on merged points (the evaluator's data must be `m.data`), counting the rows
+    /// and the constant part of chi2 as given.
+    pub fn with_merged(mut self, m: &Merged) -> Objective<'a> {
+        self.rows = m.rows;
+        self.chi2_offset = m.chi2_offset;
+        self.first_row = Some(m.first_row.clone());
+        self
     }
 
-    /// The chi2 scale s of the module doc.
+    /// Degrees of freedom, rows - k (positive: the engine refuses rows <= k).
+    pub fn dof(&self) -> usize {
+        self.rows - self.kind.n_params()
+    }
+
+    /// The chi2 scale s of the module doc, from the chi2 of the points (the residuals').
     pub fn scale(&self, chi2: f64) -> f64 {
-        let red = chi2 / self.dof() as f64;
+        let red = (chi2 + self.chi2_offset) / self.dof() as f64;
         if !self.ev.data.weighted || red > 1.0 {
             red
         } else {
@@ -119,9 +139,10 @@ impl<'a> Objective<'a> {
     /// The observation `i` described for error messages.
     pub fn describe_point(&self, i: usize) -> String {
         let o = &self.ev.data.obs[i];
+        let row = self.first_row.as_ref().map_or(i, |f| f[i]);
         format!(
             "point {} (d_mm = {}, v_n_m_s = {})",
-            i + 1,
+            row + 1,
             o.d_mm,
             o.v_n_m_s
         )

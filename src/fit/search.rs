@@ -73,9 +73,10 @@ pub struct SearchOutcome {
     pub near_nodes: Vec<(Vec<f64>, f64)>,
 }
 
-/// The tolerance tau for a best value U.
+/// The tolerance tau for a best value U of the points' chi2 (the rows' chi2 sets the relative
+/// part, as the module doc states it for the chi2 a user sees).
 pub fn tolerance(obj: &Objective, upper: f64) -> f64 {
-    TAU_REL * upper + TAU_ABS * obj.scale(upper)
+    TAU_REL * (upper + obj.chi2_offset) + TAU_ABS * obj.scale(upper)
 }
 
 /// The global minimum (see the module doc).
@@ -350,10 +351,14 @@ fn run<L: Landscape>(
             warnings.push(format!(
                 "no local polish reached the best grid point (chi2 {}{}); the grid point is \
                  reported",
-                show(node_v),
+                show(node_v + obj.chi2_offset),
                 other
                     .as_ref()
-                    .map(|f| format!(", best polish {} ({})", show(f.chi2), f.reason))
+                    .map(|f| format!(
+                        ", best polish {} ({})",
+                        show(f.chi2 + obj.chi2_offset),
+                        f.reason
+                    ))
                     .unwrap_or_default()
             ));
             Found {
@@ -380,8 +385,8 @@ fn run<L: Landscape>(
         warnings.push(format!(
             "the global search's lower bounds were contradicted (bound {}, point {}): the \
              certificate is void",
-            show(lowest_any),
-            show(best.chi2)
+            show(lowest_any + obj.chi2_offset),
+            show(best.chi2 + obj.chi2_offset)
         ));
     }
     for why in &cert.reasons {
