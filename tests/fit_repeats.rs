@@ -25,7 +25,10 @@ fn fig7() -> FitData {
         .data;
     let mut obs: Vec<Observation> = Vec::new();
     for o in &all.obs {
-        if !obs.iter().any(|p| p.d_mm == o.d_mm && p.v_n_m_s == o.v_n_m_s) {
+        if !obs
+            .iter()
+            .any(|p| p.d_mm == o.d_mm && p.v_n_m_s == o.v_n_m_s)
+        {
             obs.push(*o);
         }
     }
@@ -53,7 +56,10 @@ fn assert_same_params(a: &restitution::fit::FitResult, b: &restitution::fit::Fit
 #[test]
 fn every_row_twice() {
     let data = fig7();
-    assert!(data.merge_repeats().is_none(), "the Fig. 7 data have no repeats");
+    assert!(
+        data.merge_repeats().is_none(),
+        "the Fig. 7 data have no repeats"
+    );
     let mut obs = data.obs.clone();
     obs.extend(data.obs.iter().copied());
     let twice = FitData::new(data.material, obs).unwrap();
@@ -72,13 +78,20 @@ fn every_row_twice() {
         for (p, q) in a.params.iter().zip(&b.params) {
             if let (Some(x), Some(y)) = (p.stderr_abs, q.stderr_abs) {
                 // 1e-5: the Jacobian is a finite difference (step 1e-5) at minima 1e-7 apart.
-                assert!(rel(y * 2f64.sqrt(), x) < 1e-5, "{} {}: {x} {y}", kind.name(), p.key);
+                assert!(
+                    rel(y * 2f64.sqrt(), x) < 1e-5,
+                    "{} {}: {x} {y}",
+                    kind.name(),
+                    p.key
+                );
             }
         }
         assert_eq!(b.predicted.len(), b.n);
         assert_eq!(&b.predicted[..a.n], &b.predicted[a.n..]);
         assert!(
-            b.notes.iter().any(|n| n.contains("distinct (d, d2, v_n) points")),
+            b.notes
+                .iter()
+                .any(|n| n.contains("distinct (d, d2, v_n) points")),
             "the merge is named: {:?}",
             b.notes
         );
@@ -117,6 +130,11 @@ fn split_rows_add_a_constant() {
         );
         // The rows' residuals, not the points': each row is d/s away from its point.
         let r = &b.normalized_residuals;
-        assert!(rel((r[1] - r[0]).abs(), 2.0 * d / (data.obs[0].e_err.unwrap() * 2f64.sqrt())) < 1e-9);
+        assert!(
+            rel(
+                (r[1] - r[0]).abs(),
+                2.0 * d / (data.obs[0].e_err.unwrap() * 2f64.sqrt())
+            ) < 1e-9
+        );
     }
 }

@@ -196,7 +196,13 @@ impl FitData {
     /// products, profiles and differences of chi2. Repeated launches at one nominal speed make
     /// such data; so do files of repeated rows, which would otherwise cost the fit their count.
     pub fn merge_repeats(&self) -> Option<Merged> {
-        let key = |o: &Observation| (o.d_mm.to_bits(), o.d2_mm.map(f64::to_bits), o.v_n_m_s.to_bits());
+        let key = |o: &Observation| {
+            (
+                o.d_mm.to_bits(),
+                o.d2_mm.map(f64::to_bits),
+                o.v_n_m_s.to_bits(),
+            )
+        };
         let mut index: std::collections::HashMap<_, usize> = std::collections::HashMap::new();
         let mut point_of_row = Vec::with_capacity(self.obs.len());
         let mut first_row = Vec::new();
