@@ -149,10 +149,13 @@ pub fn fit(data: &FitData, kind: ModelKind, options: &FitOptions) -> Result<FitR
     }
     let lost_intervals = options.intervals && profiles.is_none();
     let profile_evals = obj.evals.get() - fit_evals;
+    let rows = Rows {
+        data,
+        merged: merged.as_ref(),
+    };
     let mut r = summarise(
         &obj,
-        data,
-        merged.as_ref(),
+        &rows,
         &best,
         profiles.as_ref(),
         lost_intervals,
@@ -219,11 +222,16 @@ fn check_disjoint(
     }
 }
 
-/// The result at `best`, for the rows of `data` (the objective may see them merged).
+/// The rows as given and, when repeats were merged, the points the objective sees.
+struct Rows<'a> {
+    data: &'a FitData,
+    merged: Option<&'a Merged>,
+}
+
+/// The result at `best`, for the rows as given.
 fn summarise(
     obj: &Objective,
-    data: &FitData,
-    merged: Option<&Merged>,
+    rows: &Rows,
     best: &Found,
     profiles: Option<&Profiles>,
     lost_intervals: bool,
@@ -231,6 +239,7 @@ fn summarise(
     warnings: &mut Vec<String>,
 ) -> Result<FitResult> {
     let kind = obj.kind;
+    let (data, merged) = (rows.data, rows.merged);
     let n = data.len();
     let k = kind.n_params();
     let theta = best.theta.clone();
