@@ -338,7 +338,8 @@ impl Contact {
         (PI * sigma_y_pa / (2.0 * self.e_star_pa)).powi(2) * self.r_eff_m
     }
 
-    /// Elastic work up to yield, W_y = (2/5) K delta_y^(5/2) (Eq. 13).
+    /// Elastic work up to yield, W_y = (2/5) K delta_y^(5/2) (the paper's Appendix B;
+    /// docs/physics.md §3).
     pub fn yield_work_j(&self, sigma_y_pa: f64) -> f64 {
         0.4 * self.hertz_k() * self.yield_overlap_m(sigma_y_pa).powf(2.5)
     }

@@ -382,7 +382,7 @@ mod tests {
         assert!((c.pixel_m() - 0.25e-3).abs() < 1e-15);
         assert!((c.sigma_m() - 0.125e-3).abs() < 1e-15);
         // Eq. (8) at 1 m/s, N = 10: 0.125 mm / (1 ms sqrt 10) = 0.0395 m/s, the paper's "about 4%".
-        let dv = crate::kinematics::eq8_velocity_error_m_s(2.0, c.subpixel_m(), c.dt_s(), 10);
+        let dv = crate::kinematics::eq8_velocity_error_m_s(2.0, c.subpixel_m(), c.dt_s(), 10.0);
         assert!((dv - 0.0395).abs() < 1e-4, "{dv}");
     }
 

@@ -4,8 +4,9 @@
 //! **Search box** (wide enough for any data a user can have; checked finite before any grid is
 //! built, with an error naming the data otherwise):
 //! - log eta such that the largest kappa in the data lies in [1e-8, 0.999 KAPPA_MAX]: below,
-//!   1 - e is under 1.2e-8 at every point (elastic for any measurement); above, e < 1e-9 and the
-//!   master curve would hand over to the ODE;
+//!   1 - e is under 1.2e-8 at every point (elastic for any measurement); above, e < 1e-9 with
+//!   the overlap rule (6.1e-4 with the force rule: a fit to such data ends at the box's edge and
+//!   says so) and the master curve hands over to its large-kappa laws;
 //! - log sigma_y from where every point has V/V_Y >= 1e6 (e_pm < 0.04) up to where no point
 //!   yields (V_Y >= 1.5 v for every point: the plateau where sigma_y stops mattering);
 //! - powerlaw: A in [1e-9, 1e3], a and b in [-10, 10], the exponents narrowed (with a warning)

@@ -21,7 +21,8 @@
 //! collision's fits (a fit of 10 frames alone estimates its own noise poorly), propagated to the
 //! velocities at the collision time. Eq. (8)'s Delta v = s d/(n_s dt sqrt N) is reported next to it:
 //! it ignores that the slope is taken at the end of the window, where a quadratic fit's slope has
-//! about 1.4 times that spread (docs/physics.md §5).
+//! a larger spread (1.3-1.6 times at N = 10 frames, 1.6-2.0 at 8, less beyond 12: the table in
+//! docs/physics.md §5.4).
 //!
 //! **Needs**: at least 3 frames per phase (free fits) or 2 (fixed gravity), distinct times.
 
@@ -328,13 +329,8 @@ pub fn analyse(
 /// Eq. (8): Delta v = s d/(n_s dt sqrt N) = s * (subpixel size)/(dt sqrt N), with s the position
 /// accuracy in subpixels, the subpixel size in metres, dt the frame interval and N the frames in
 /// the fit. Optimistic for a slope at the end of the frame window (docs/physics.md §5).
-pub fn eq8_velocity_error_m_s(
-    s_subpixels: f64,
-    subpixel_m: f64,
-    dt_s: f64,
-    n_frames: usize,
-) -> f64 {
-    s_subpixels * subpixel_m / (dt_s * (n_frames as f64).sqrt())
+pub fn eq8_velocity_error_m_s(s_subpixels: f64, subpixel_m: f64, dt_s: f64, n_frames: f64) -> f64 {
+    s_subpixels * subpixel_m / (dt_s * n_frames.sqrt())
 }
 
 /// e and v_n of one collision from its tracks, without error propagation (for Monte Carlo
@@ -378,7 +374,8 @@ pub struct Measurement {
     pub e_err: f64,
     /// Standard error of v_n from the fits' covariance, m/s.
     pub v_n_err_m_s: f64,
-    /// Eq. (8) for a relative velocity component, with N the mean frames per phase, m/s.
+    /// Eq. (8): the error of one sphere's velocity component (docs/physics.md §5.4-5.5), with N
+    /// the mean number of frames of the pre- and post-collision fits, m/s.
     pub eq8_dv_m_s: f64,
     /// The paper's error of e from Eq. (8): Delta e = 2 e Delta v / v_n.
     pub e_err_eq8: f64,
@@ -433,7 +430,8 @@ pub fn measure_collision(
         .windows(2)
         .map(|w| w[1].t_s - w[0].t_s)
         .fold(f64::INFINITY, f64::min);
-    let n_mean = (k.n_pre + k.n_post) / 2;
+    // The mean, not its integer part: 9 and 10 frames are N = 9.5, not 9.
+    let n_mean = (k.n_pre + k.n_post) as f64 / 2.0;
     let eq8_dv = eq8_velocity_error_m_s(eq8.s_subpixels, eq8.subpixel_m, dt, n_mean);
     Ok(Measurement {
         sigma_pos_m: sigma,
@@ -518,7 +516,7 @@ mod tests {
         let end = f.slope_variance_factor(9.5).sqrt();
         assert!((end - 0.4489043901713944).abs() < 1e-12, "{end}");
         assert!((f.slope_variance_factor(9.0).sqrt() - 0.4068541544955674).abs() < 1e-12);
-        assert!((eq8_velocity_error_m_s(1.0, 1.0, 1.0, 10) - 0.316227766).abs() < 1e-9);
+        assert!((eq8_velocity_error_m_s(1.0, 1.0, 1.0, 10.0) - 0.316227766).abs() < 1e-9);
     }
 
     #[test]

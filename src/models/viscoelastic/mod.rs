@@ -50,7 +50,7 @@ use std::str::FromStr;
 pub enum ContactEnd {
     /// The paper's rule: the first t > 0 with delta = 0.
     Overlap,
-    /// Schwager & Poeschel (2007): the first t > 0 where the contact force returns to zero.
+    /// Schwager & Poeschel, PRE 78, 051304 (2008): the first t > 0 where the contact force returns to zero.
     Force,
 }
 
