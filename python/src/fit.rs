@@ -5,6 +5,7 @@ use crate::{Failure, Outcome, Source, run_detached};
 use pyo3::prelude::*;
 use restitution::fit::input::{FitInput, parse_fit_csv, read_fit_csv};
 use restitution::fit::report::{self, ReportContext};
+use restitution::fit::report_text;
 use restitution::fit::{FitOptions, FitSet, ModelKind, fit_all};
 use restitution::models::viscoelastic::{ContactEnd, OdeSettings, VmMethod};
 use restitution::plot::fit::{fig7_svg, residuals_svg};
@@ -49,17 +50,17 @@ impl Fitted {
 
     /// The human table `restitution fit` prints.
     fn table_text(&self) -> String {
-        report::to_table(&self.ctx(), &self.set)
+        report_text::to_table(&self.ctx(), &self.set)
     }
 
     /// params.md of `restitution fit --out`.
     fn markdown(&self) -> String {
-        report::to_markdown(&self.ctx(), &self.set)
+        report_text::to_markdown(&self.ctx(), &self.set)
     }
 
     /// params.csv of `restitution fit --out` (and `--format csv`).
-    fn csv(&self) -> String {
-        report::to_csv(&self.ctx(), &self.set)
+    fn csv(&self) -> PyResult<String> {
+        report::to_csv(&self.ctx(), &self.set).map_err(pyo3::exceptions::PyValueError::new_err)
     }
 
     /// fig7.svg of `restitution fit --out`, with the given title.

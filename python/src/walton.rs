@@ -6,8 +6,9 @@
 use crate::{Failure, Outcome, Source, run_detached};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use restitution::data::walton::{measure_records, read_collisions};
 use restitution::fit::walton::{
-    self as wfit, Bound as WBound, Estimate, FitOptions, WaltonFit, Weights, read_collisions,
+    self as wfit, Bound as WBound, Estimate, FitOptions, WaltonFit, Weights,
 };
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -167,7 +168,7 @@ fn walton_fit<'py>(
         }
         let table = source?.table()?;
         let (records, warnings) = read_collisions(&table, &material, inertia_k)?;
-        let measured = wfit::measure_records(&table.path, &records)?;
+        let measured = measure_records(&table.path, &records)?;
         let options = FitOptions {
             inertia_k,
             weights,
