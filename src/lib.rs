@@ -12,6 +12,7 @@ pub mod frames;
 pub mod kinematics;
 pub mod models;
 pub mod plot;
+pub mod predict;
 pub mod synthetic;
 
 pub use error::{Error, Result};

@@ -4,11 +4,11 @@
 use crate::{Failure, Outcome, run_detached};
 use numpy::{IntoPyArray, PyArray1, PyArrayMethods, PyReadonlyArray1};
 use pyo3::prelude::*;
+use restitution::data::fmt_num;
 use restitution::fit::dataset::pair_contact;
-use restitution::models::plastic::{self, Plastic};
-use restitution::models::viscoelastic::{
-    self, ContactEnd, Integrator, OdeSettings, Viscoelastic, VmMethod,
-};
+use restitution::models::plastic;
+use restitution::models::viscoelastic::{self, ContactEnd, Integrator, OdeSettings, VmMethod};
+use restitution::predict as table;
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(e_of_kappa, m)?)?;
@@ -198,7 +198,13 @@ impl Geometry {
                 "d_mm = {d_mm}: expected a diameter > 0 (mm)"
             )));
         }
-        pair_contact(material, d_mm, d2).map_err(|e| Failure::library("", &e))
+        // Named as the command line names it (`--d-mm 1e-300: ...`), in Python's words.
+        let named = match (self.d2_mm, self.wall) {
+            (Some(d2), _) => format!("d_mm = {}, d2_mm = {}", fmt_num(d_mm), fmt_num(d2)),
+            (None, true) => format!("d_mm = {}, wall = True", fmt_num(d_mm)),
+            (None, false) => format!("d_mm = {}", fmt_num(d_mm)),
+        };
+        pair_contact(material, d_mm, d2).map_err(|e| Failure::library(&named, &e))
     }
 }
 
@@ -255,11 +261,17 @@ fn predict<'py>(
         match (model.as_str(), v, kappa, u) {
             ("vm", _, Some(k), _) => {
                 check("kappa", &k, |k| k >= 0.0, "a number >= 0")?;
-                vm_dimensionless(&k, rule, &method, &ode, full_output)
+                columns(table::vm_dimensionless(
+                    &k,
+                    rule,
+                    &method,
+                    &ode,
+                    full_output,
+                ))
             }
             ("pm", _, _, Some(u)) => {
                 check("u", &u, |u| u >= 0.0, "a number >= 0")?;
-                Ok(pm_dimensionless(&u))
+                columns(table::pm_dimensionless(&u))
             }
             ("vm", _, _, Some(_)) => {
                 Err(Failure::Input("u is for model='pm'; vm takes kappa".into()))
@@ -273,115 +285,59 @@ fn predict<'py>(
                 if model == "vm" {
                     let eta = eta
                         .ok_or_else(|| Failure::Input("model='vm' needs eta (kg/(s m))".into()))?;
-                    vm_dimensional(&v, contact, eta, rule, &method, &ode, full_output)
+                    columns(table::vm_dimensional(
+                        contact,
+                        eta,
+                        &v,
+                        rule,
+                        &method,
+                        &ode,
+                        full_output,
+                    ))
                 } else {
                     let sy = sigma_y_pa
                         .ok_or_else(|| Failure::Input("model='pm' needs sigma_y_pa (Pa)".into()))?;
-                    pm_dimensional(&v, contact, sy)
+                    columns(table::pm_dimensional(contact, sy, &v))
                 }
             }
             (m, ..) => Err(Failure::Input(format!("model '{m}': expected vm or pm"))),
         }
     })?;
+    let (columns, notes) = columns;
+    for note in notes {
+        PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyUserWarning>(),
+            &std::ffi::CString::new(note).unwrap_or_default(),
+            1,
+        )?;
+    }
     Ok(columns
         .into_iter()
         .map(|(name, values)| (name, values.into_pyarray(py)))
         .collect())
 }
 
-fn vm_dimensionless(
-    kappa: &[f64],
-    rule: ContactEnd,
-    method: &VmMethod,
-    ode: &OdeSettings,
-    full: bool,
-) -> Outcome<Columns> {
-    let n = kappa.len();
-    let mut c: [Vec<f64>; 5] = std::array::from_fn(|_| Vec::with_capacity(n));
-    for &k in kappa {
-        let e = viscoelastic::restitution(k, rule, method).map_err(|e| Failure::library("", &e))?;
-        c[0].push(e.e);
-        c[1].push(e.one_minus_e);
-        if full {
-            let r = viscoelastic::rebound(k, rule, ode).map_err(|e| Failure::library("", &e))?;
-            c[2].push(r.tau_contact);
-            c[3].push(r.x_max);
-            c[4].push(r.force_max);
+/// The library's table as named columns (a cell the ODE could not give is NaN, with the note
+/// that says why), or its failure as the Python error of the same one line.
+fn columns(r: Result<table::Table, table::Failure>) -> Outcome<(Columns, Vec<String>)> {
+    let t = r.map_err(|f| {
+        if f.error.integration_failure().is_some() {
+            Failure::Numerical(f.to_string())
+        } else {
+            Failure::Input(f.to_string())
         }
-    }
-    let [e, ome, tau, x, f] = c;
-    let mut out = vec![("kappa", kappa.to_vec()), ("e", e), ("one_minus_e", ome)];
-    if full {
-        out.extend([("tau_contact", tau), ("x_max", x), ("force_max", f)]);
-    }
-    Ok(out)
-}
-
-fn pm_dimensionless(u: &[f64]) -> Columns {
-    let r: Vec<_> = u.iter().map(|&u| plastic::rebound_u(u)).collect();
-    vec![
-        ("u", u.to_vec()),
-        ("e", r.iter().map(|r| r.e).collect()),
-        ("one_minus_e", r.iter().map(|r| r.one_minus_e).collect()),
-    ]
-}
-
-fn vm_dimensional(
-    v: &[f64],
-    contact: restitution::contact::Contact,
-    eta: f64,
-    rule: ContactEnd,
-    method: &VmMethod,
-    ode: &OdeSettings,
-    full: bool,
-) -> Outcome<Columns> {
-    let model = Viscoelastic::new(contact, eta)
-        .map_err(|e| Failure::library(&format!("eta = {eta}"), &e))?;
-    let n = v.len();
-    let mut c: [Vec<f64>; 6] = std::array::from_fn(|_| Vec::with_capacity(n));
-    for &v in v {
-        let kappa = model.kappa(v);
-        let e =
-            viscoelastic::restitution(kappa, rule, method).map_err(|e| Failure::library("", &e))?;
-        c[0].push(e.e);
-        c[1].push(e.one_minus_e);
-        c[2].push(kappa);
-        if full {
-            let i = model
-                .impact(v, rule, ode)
-                .map_err(|e| Failure::library("", &e))?;
-            c[3].push(i.contact_time_s);
-            c[4].push(i.max_overlap_m);
-            c[5].push(i.max_force_n);
-        }
-    }
-    let [e, ome, kappa, t, x, f] = c;
-    let mut out = vec![
-        ("v_m_s", v.to_vec()),
-        ("e", e),
-        ("one_minus_e", ome),
-        ("kappa", kappa),
-    ];
-    if full {
-        out.extend([
-            ("contact_time_s", t),
-            ("max_overlap_m", x),
-            ("max_force_n", f),
-        ]);
-    }
-    Ok(out)
-}
-
-fn pm_dimensional(v: &[f64], contact: restitution::contact::Contact, sy: f64) -> Outcome<Columns> {
-    let model = Plastic::new(contact, sy)
-        .map_err(|e| Failure::library(&format!("sigma_y_pa = {sy}"), &e))?;
-    let vy = model.yield_velocity_m_s();
-    let r: Vec<_> = v.iter().map(|&v| plastic::rebound_u(v / vy)).collect();
-    Ok(vec![
-        ("v_m_s", v.to_vec()),
-        ("e", r.iter().map(|r| r.e).collect()),
-        ("one_minus_e", r.iter().map(|r| r.one_minus_e).collect()),
-        ("u", v.iter().map(|&v| v / vy).collect()),
-        ("v_yield_m_s", vec![vy; v.len()]),
-    ])
+    })?;
+    let cols = t
+        .columns
+        .iter()
+        .enumerate()
+        .map(|(j, &name)| {
+            (
+                name,
+                t.rows.iter().map(|r| r[j].unwrap_or(f64::NAN)).collect(),
+            )
+        })
+        .collect();
+    Ok((cols, t.notes))
 }

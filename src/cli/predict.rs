@@ -20,12 +20,9 @@
 
 use super::{CliResult, Format, MaterialArgs};
 use restitution::contact::{Contact, Pair, Sphere};
-use restitution::data::fmt_num;
-use restitution::error::IntegrationFailure;
-use restitution::models::plastic::{self, Plastic};
-use restitution::models::viscoelastic::{
-    self, ContactEnd, Integrator, OdeSettings, Viscoelastic, VmMethod,
-};
+use restitution::data::{CsvOut, fmt_num};
+use restitution::models::viscoelastic::{ContactEnd, Integrator, OdeSettings, VmMethod};
+use restitution::predict::{self, Table};
 
 #[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Model {
@@ -90,11 +87,14 @@ fn parse_rule(s: &str) -> Result<ContactEnd, String> {
     s.parse()
 }
 
-/// A result table: column names and rows of numbers (`None`: not available, see `notes`).
-struct Out {
-    columns: Vec<&'static str>,
-    rows: Vec<Vec<Option<f64>>>,
-    notes: Vec<String>,
+/// The one line of a library failure: the input's flag, its value and why.
+fn flagged(f: predict::Failure) -> String {
+    format!(
+        "--{} {}: {}",
+        f.input.key().replace('_', "-"),
+        fmt_num(f.value),
+        f.error
+    )
 }
 
 pub fn run(args: Args) -> CliResult {
@@ -110,14 +110,15 @@ pub fn run(args: Args) -> CliResult {
         MethodArg::Master => VmMethod::Master,
         _ => VmMethod::Ode(ode),
     };
+    let rule = args.contact_end;
     let out = match args.model {
         Model::Vm if !args.kappa.is_empty() => {
             check_all("--kappa", &args.kappa, |k| k >= 0.0, "a number >= 0")?;
-            vm_dimensionless(&args, &method, &ode)?
+            predict::vm_dimensionless(&args.kappa, rule, &method, &ode, true).map_err(flagged)?
         }
         Model::Pm if !args.u.is_empty() => {
             check_all("--u", &args.u, |u| u >= 0.0, "a number >= 0")?;
-            pm_dimensionless(&args.u)?
+            predict::pm_dimensionless(&args.u).map_err(flagged)?
         }
         Model::Vm if !args.u.is_empty() => {
             return Err("--u is for --model pm; vm takes --kappa".into());
@@ -132,9 +133,18 @@ pub fn run(args: Args) -> CliResult {
             check_all("--v-m-s", &args.v_m_s, |v| v > 0.0, "a speed > 0")?;
             let contact = contact_from(&args)?;
             match args.model {
-                Model::Vm => vm_dimensional(&args, contact, &method, &ode)?,
-                Model::Pm => pm_dimensional(&args, contact)?,
+                Model::Vm => {
+                    let eta = args.eta.ok_or("--model vm needs --eta (kg/(s m))")?;
+                    predict::vm_dimensional(contact, eta, &args.v_m_s, rule, &method, &ode, true)
+                }
+                Model::Pm => {
+                    let sy = args
+                        .sigma_y_pa
+                        .ok_or("--model pm needs --sigma-y-pa (Pa)")?;
+                    predict::pm_dimensional(contact, sy, &args.v_m_s)
+                }
             }
+            .map_err(flagged)?
         }
     };
     for note in &out.notes {
@@ -165,165 +175,23 @@ fn contact_from(args: &Args) -> Result<Contact, String> {
         (None, true) => Pair::on_wall(sphere, material),
         (None, false) => Pair::identical(sphere),
     };
-    pair.try_contact().map_err(|e| e.to_string())
+    let flags = match (args.d2_mm, args.wall) {
+        (Some(d2), _) => format!("--d-mm {} --d2-mm {}", fmt_num(d_mm), fmt_num(d2)),
+        (None, true) => format!("--d-mm {} --wall", fmt_num(d_mm)),
+        (None, false) => format!("--d-mm {}", fmt_num(d_mm)),
+    };
+    pair.try_contact().map_err(|e| format!("{flags}: {e}"))
 }
 
-/// The ODE's extra figures (contact time and extrema), or `None` with a note when kappa is
-/// beyond the ODE's checked range; any other ODE failure is an error.
-fn extrema<T>(
-    kappa: f64,
-    rule: ContactEnd,
-    result: restitution::Result<T>,
-    notes: &mut Vec<String>,
-) -> Result<Option<T>, String> {
-    match result {
-        Ok(r) => Ok(Some(r)),
-        Err(e) if e.integration_failure() == Some(IntegrationFailure::OutOfRange) => {
-            notes.push(format!(
-                "kappa = {}: contact time and extrema left empty: {e}",
-                fmt_num(kappa)
-            ));
-            let _ = rule;
-            Ok(None)
-        }
-        Err(e) => Err(e.to_string()),
-    }
-}
-
-fn vm_dimensionless(args: &Args, method: &VmMethod, ode: &OdeSettings) -> Result<Out, String> {
-    let mut rows = Vec::new();
-    let mut notes = Vec::new();
-    for &k in &args.kappa {
-        let e =
-            viscoelastic::restitution(k, args.contact_end, method).map_err(|e| e.to_string())?;
-        let r = extrema(
-            k,
-            args.contact_end,
-            viscoelastic::rebound(k, args.contact_end, ode),
-            &mut notes,
-        )?;
-        rows.push(vec![
-            Some(k),
-            Some(e.e),
-            Some(e.one_minus_e),
-            r.map(|r| r.tau_contact),
-            r.map(|r| r.x_max),
-            r.map(|r| r.force_max),
-        ]);
-    }
-    Ok(Out {
-        columns: vec![
-            "kappa",
-            "e",
-            "one_minus_e",
-            "tau_contact",
-            "x_max",
-            "force_max",
-        ],
-        rows,
-        notes,
-    })
-}
-
-fn pm_dimensionless(us: &[f64]) -> Result<Out, String> {
-    let mut rows = Vec::new();
-    for &u in us {
-        let r = plastic::try_rebound_u(u).map_err(|e| format!("--u {}: {e}", fmt_num(u)))?;
-        rows.push(vec![Some(u), Some(r.e), Some(r.one_minus_e)]);
-    }
-    Ok(Out {
-        columns: vec!["u", "e", "one_minus_e"],
-        rows,
-        notes: Vec::new(),
-    })
-}
-
-fn vm_dimensional(
-    args: &Args,
-    contact: Contact,
-    method: &VmMethod,
-    ode: &OdeSettings,
-) -> Result<Out, String> {
-    let eta = args.eta.ok_or("--model vm needs --eta (kg/(s m))")?;
-    let model = Viscoelastic::new(contact, eta).map_err(|e| format!("--eta {eta}: {e}"))?;
-    let mut rows = Vec::new();
-    let mut notes = Vec::new();
-    for &v in &args.v_m_s {
-        let kappa = model
-            .try_kappa(v)
-            .map_err(|e| format!("--v-m-s {}: {e}", fmt_num(v)))?;
-        let e = viscoelastic::restitution(kappa, args.contact_end, method)
-            .map_err(|e| e.to_string())?;
-        let i = extrema(
-            kappa,
-            args.contact_end,
-            model.impact(v, args.contact_end, ode),
-            &mut notes,
-        )?;
-        rows.push(vec![
-            Some(v),
-            Some(e.e),
-            Some(e.one_minus_e),
-            Some(kappa),
-            i.map(|i| i.contact_time_s),
-            i.map(|i| i.max_overlap_m),
-            i.map(|i| i.max_force_n),
-        ]);
-    }
-    Ok(Out {
-        columns: vec![
-            "v_m_s",
-            "e",
-            "one_minus_e",
-            "kappa",
-            "contact_time_s",
-            "max_overlap_m",
-            "max_force_n",
-        ],
-        rows,
-        notes,
-    })
-}
-
-fn pm_dimensional(args: &Args, contact: Contact) -> Result<Out, String> {
-    let sy = args
-        .sigma_y_pa
-        .ok_or("--model pm needs --sigma-y-pa (Pa)")?;
-    let model = Plastic::new(contact, sy).map_err(|e| format!("--sigma-y-pa {sy:e}: {e}"))?;
-    let vy = model.yield_velocity_m_s();
-    let mut rows = Vec::new();
-    for &v in &args.v_m_s {
-        let u = model
-            .u(v)
-            .map_err(|e| format!("--v-m-s {}: {e}", fmt_num(v)))?;
-        let r = plastic::rebound_u(u);
-        rows.push(vec![
-            Some(v),
-            Some(r.e),
-            Some(r.one_minus_e),
-            Some(u),
-            Some(vy),
-        ]);
-    }
-    Ok(Out {
-        columns: vec!["v_m_s", "e", "one_minus_e", "u", "v_yield_m_s"],
-        rows,
-        notes: Vec::new(),
-    })
-}
-
-fn render(out: &Out, format: Format) -> String {
+fn render(out: &Table, format: Format) -> String {
     match format {
         Format::Csv => {
-            let mut s = out.columns.join(",") + "\n";
+            let mut csv = CsvOut::new();
+            csv.record(out.columns.iter().copied());
             for row in &out.rows {
-                let cells: Vec<String> = row
-                    .iter()
-                    .map(|x| x.map_or(String::new(), fmt_num))
-                    .collect();
-                s += &(cells.join(",") + "\n");
+                csv.record(row.iter().map(|x| x.map_or(String::new(), fmt_num)));
             }
-            s
+            csv.into_string()
         }
         Format::Json => {
             let rows: Vec<serde_json::Value> = out

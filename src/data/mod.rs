@@ -72,12 +72,7 @@ pub fn shown(raw: &str) -> String {
 /// Formats a number in shortest round-trip form (Rust's `{}`/`{:e}` print the fewest digits that
 /// parse back to the same f64); exponent form outside [1e-4, 1e16).
 pub fn fmt_num(x: f64) -> String {
-    let a = x.abs();
-    if x == 0.0 || !x.is_finite() || (1e-4..1e16).contains(&a) {
-        format!("{x}")
-    } else {
-        format!("{x:e}")
-    }
+    crate::error::Num(x).to_string()
 }
 
 #[cfg(test)]

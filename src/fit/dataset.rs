@@ -76,7 +76,7 @@ pub fn pair_contact(material: Material, d_mm: f64, d2_mm: Option<f64>) -> Result
         Some(d2) if d2 == f64::INFINITY => Pair::on_wall(s1, material),
         Some(d2) => Pair::unequal(s1, Sphere::new(d2 * 1e-3, material)?),
     };
-    Ok(pair.contact())
+    pair.try_contact()
 }
 
 impl FitData {
