@@ -4,6 +4,7 @@ properties from tracked sphere centres (`restitution walton fit`, `restitution k
 from __future__ import annotations
 
 import copy
+import warnings
 import html
 from typing import Any, Dict, List, Optional
 
@@ -162,6 +163,9 @@ class KinematicsResult:
         Collisions that could not be measured, with the reason (the CLI's warnings).
     fits_meet : list of str
         Collisions whose time is where pre- and post-collision fits meet (the fallback rule).
+    unmeasured_spins : list of str
+        Collisions with empty spin cells, taken as 0 in beta and psi (the CLI's warnings; each
+        is also issued as a ``UserWarning``).
     """
 
     def __init__(self, doc: Dict[str, Any]):
@@ -169,6 +173,9 @@ class KinematicsResult:
         self.sigma_pos_m: float = doc["sigma_pos_m"]
         self.skipped: List[str] = doc["skipped"]
         self.fits_meet: List[str] = doc["fits_meet"]
+        self.unmeasured_spins: List[str] = doc["unmeasured_spins"]
+        for line in self.unmeasured_spins:
+            warnings.warn(line, UserWarning, stacklevel=3)
 
     def to_dict(self) -> Dict[str, Any]:
         return copy.deepcopy(self._doc)

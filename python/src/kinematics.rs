@@ -10,10 +10,8 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use restitution::data::tracks::parse_tracks;
 use restitution::experiment::Camera;
-use restitution::kinematics::{
-    Eq8Inputs, FitKind, G_STANDARD_M_S2, Measurement, TimeRule, analyse, measure_collision,
-    split_at_contact,
-};
+use restitution::kinematics::batch::{BatchOptions, CollisionInput, measure_batch};
+use restitution::kinematics::{Eq8Inputs, FitKind, G_STANDARD_M_S2, Measurement, TimeRule};
 use restitution::models::walton::K_HOMOGENEOUS;
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -42,6 +40,8 @@ struct Done {
     sigma_pos_m: f64,
     subpixel_m: f64,
     skipped: Vec<String>,
+    /// Spins not measured, taken as 0 (one line per collision, as the CLI warns).
+    unmeasured: Vec<String>,
 }
 
 /// Velocities, e, beta and psi from tracked centres, as `restitution kinematics` computes them.
@@ -124,57 +124,51 @@ fn kinematics<'py>(
         let place = |t: &restitution::data::tracks::CollisionTrack| {
             format!("{}:{}: collision '{}'", table.path, t.first_line, t.id)
         };
-        // Pass 1: fits only, to pool the residuals of every collision into one noise estimate.
-        let mut splits = Vec::new();
-        let (mut rss, mut dof) = (0.0, 0usize);
-        let mut skipped = Vec::new();
-        for t in &tracks {
-            let split = t
-                .split
-                .map(Ok)
-                .unwrap_or_else(|| split_at_contact(&t.frames, kind));
-            match split.and_then(|s| analyse(&t.frames, s, t.d1_m, t.d2_m, kind).map(|k| (s, k))) {
-                Ok((s, k)) => {
-                    rss += k.rss_m2;
-                    dof += k.dof;
-                    splits.push(Some(s));
-                }
-                Err(e) => {
-                    skipped.push(format!("{}: {e}", place(t)));
-                    splits.push(None);
-                }
-            }
-        }
-        let sigma = if dof > 0 {
-            (rss / dof as f64).sqrt()
-        } else {
-            eq8.s_subpixels * eq8.subpixel_m
+        let inputs: Vec<CollisionInput> = tracks
+            .iter()
+            .map(|t| CollisionInput {
+                frames: &t.frames,
+                split: t.split,
+                d1_m: t.d1_m,
+                d2_m: t.d2_m,
+                spins_rad_s: t.spins_rad_s,
+            })
+            .collect();
+        let options = BatchOptions {
+            material,
+            inertia_k,
+            kind,
+            eq8,
         };
-        // Pass 2: every collision measured with the pooled noise.
-        let mut rows = Vec::new();
-        for (t, split) in tracks.iter().zip(&splits) {
-            let Some(split) = *split else { continue };
-            match measure_collision(
-                &t.frames,
-                split,
-                t.d1_m,
-                t.d2_m,
-                &material,
-                inertia_k,
-                t.spins_rad_s.unwrap_or([0.0; 4]),
-                kind,
-                &eq8,
-                Some(sigma),
-            ) {
-                Ok(m) => rows.push(Row {
-                    id: t.id.clone(),
-                    d1_mm: t.d1_m * 1e3,
-                    d2_mm: t.d2_m * 1e3,
-                    m,
-                }),
-                Err(e) => skipped.push(format!("{}: {e}", place(t))),
-            }
-        }
+        // The command line's batch: the noise pooled over every collision.
+        let batch = measure_batch(&inputs, &options);
+        let sigma = batch.sigma_pos_m;
+        let mut skipped: Vec<String> = batch
+            .skipped
+            .iter()
+            .map(|(i, e)| format!("{}: {e}", place(&tracks[*i])))
+            .collect();
+        let unmeasured: Vec<String> = batch
+            .unmeasured_spins
+            .iter()
+            .map(|(i, names)| {
+                format!(
+                    "{}: {} not measured (empty): taken as 0 in beta and psi",
+                    place(&tracks[*i]),
+                    names.join(", ")
+                )
+            })
+            .collect();
+        let rows: Vec<Row> = batch
+            .measured
+            .into_iter()
+            .map(|(i, m)| Row {
+                id: tracks[i].id.clone(),
+                d1_mm: tracks[i].d1_m * 1e3,
+                d2_mm: tracks[i].d2_m * 1e3,
+                m,
+            })
+            .collect();
         if !skipped.is_empty() && (strict || rows.is_empty()) {
             return Err(Failure::Input(skipped.swap_remove(0)));
         }
@@ -183,6 +177,7 @@ fn kinematics<'py>(
             sigma_pos_m: sigma,
             subpixel_m,
             skipped,
+            unmeasured,
         })
     })?;
     to_dict(py, &done)
@@ -253,6 +248,7 @@ fn to_dict<'py>(py: Python<'py>, done: &Done) -> PyResult<Bound<'py, PyDict>> {
     d.set_item("sigma_pos_m", done.sigma_pos_m)?;
     d.set_item("subpixel_m", done.subpixel_m)?;
     d.set_item("skipped", done.skipped.clone())?;
+    d.set_item("unmeasured_spins", done.unmeasured.clone())?;
     d.set_item(
         "fits_meet",
         rows.iter()

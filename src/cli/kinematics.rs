@@ -24,9 +24,8 @@ use restitution::data::walton::write_collisions;
 use restitution::data::{CsvOut, fmt_num, write_all_atomic};
 use restitution::experiment::Camera;
 use restitution::fit::walton::CollisionRecord;
-use restitution::kinematics::{
-    Eq8Inputs, FitKind, G_STANDARD_M_S2, Measurement, analyse, measure_collision, split_at_contact,
-};
+use restitution::kinematics::batch::{BatchOptions, CollisionInput, measure_batch};
+use restitution::kinematics::{Eq8Inputs, FitKind, G_STANDARD_M_S2, Measurement};
 use restitution::models::walton::K_HOMOGENEOUS;
 use std::path::PathBuf;
 
@@ -197,8 +196,6 @@ pub fn run(args: Args) -> CliResult {
     };
     let tracks = read_tracks(&args.path).map_err(|e| e.to_string())?;
     let shown = args.path.display().to_string();
-    // Two passes: the position noise is one camera's, so the residuals of all collisions are
-    // pooled into one estimate (a 10-frame fit alone estimates it poorly), then every error uses it.
     let place = |t: &restitution::data::tracks::CollisionTrack| {
         format!(
             "{shown}:{}: collision '{}'",
@@ -206,57 +203,43 @@ pub fn run(args: Args) -> CliResult {
             restitution::data::shown(&t.id)
         )
     };
-    let mut splits = Vec::new();
-    let (mut rss, mut dof) = (0.0, 0usize);
-    // A collision that cannot be measured (too few frames, receding spheres) is skipped with a
-    // warning naming it, so one bad track does not lose a campaign; --strict makes it an error.
-    let mut skipped = Vec::new();
-    for t in &tracks {
-        let split = t
-            .split
-            .map(Ok)
-            .unwrap_or_else(|| split_at_contact(&t.frames, kind));
-        match split
-            .and_then(|split| analyse(&t.frames, split, t.d1_m, t.d2_m, kind).map(|k| (split, k)))
-        {
-            Ok((split, k)) => {
-                rss += k.rss_m2;
-                dof += k.dof;
-                splits.push(Some(split));
-            }
-            Err(e) => {
-                skipped.push(format!("{}: {e}", place(t)));
-                splits.push(None);
-            }
-        }
-    }
-    let sigma = if dof > 0 {
-        (rss / dof as f64).sqrt()
-    } else {
-        eq8.s_subpixels * eq8.subpixel_m
+    let inputs: Vec<CollisionInput> = tracks
+        .iter()
+        .map(|t| CollisionInput {
+            frames: &t.frames,
+            split: t.split,
+            d1_m: t.d1_m,
+            d2_m: t.d2_m,
+            spins_rad_s: t.spins_rad_s,
+        })
+        .collect();
+    let options = BatchOptions {
+        material,
+        inertia_k: args.inertia_k,
+        kind,
+        eq8,
     };
+    // The noise pooled over every collision; a collision that cannot be measured (too few
+    // frames, receding spheres) is skipped with a warning naming it, so one bad track does not
+    // lose a campaign; --strict makes it an error.
+    let batch = measure_batch(&inputs, &options);
+    let sigma = batch.sigma_pos_m;
+    let mut skipped: Vec<(usize, String)> = batch
+        .skipped
+        .iter()
+        .map(|(i, e)| (*i, format!("{}: {e}", place(&tracks[*i]))))
+        .collect();
+    for (i, names) in &batch.unmeasured_spins {
+        super::warn(format_args!(
+            "{}: {} not measured (empty): taken as 0 in beta and psi",
+            place(&tracks[*i]),
+            names.join(", ")
+        ));
+    }
     let mut rows = Vec::new();
     let mut records = Vec::new();
-    for (t, split) in tracks.iter().zip(&splits) {
-        let Some(split) = *split else { continue };
-        let m = match measure_collision(
-            &t.frames,
-            split,
-            t.d1_m,
-            t.d2_m,
-            &material,
-            args.inertia_k,
-            t.spins_rad_s.unwrap_or([0.0; 4]),
-            kind,
-            &eq8,
-            Some(sigma),
-        ) {
-            Ok(m) => m,
-            Err(e) => {
-                skipped.push(format!("{}: {e}", place(t)));
-                continue;
-            }
-        };
+    for (i, m) in batch.measured {
+        let t = &tracks[i];
         let row = Row {
             id: t.id.clone(),
             d1_mm: t.d1_m * 1e3,
@@ -270,9 +253,12 @@ pub fn run(args: Args) -> CliResult {
             .zip(row.cells())
             .find(|(c, v)| **c != "collision" && (v == "NaN" || v.ends_with("inf")))
         {
-            skipped.push(format!(
-                "{}: {col} = {v} (the tracks or flags are out of range)",
-                place(t)
+            skipped.push((
+                i,
+                format!(
+                    "{}: {col} = {v} (the tracks or flags are out of range)",
+                    place(t)
+                ),
             ));
             continue;
         }
@@ -284,9 +270,11 @@ pub fn run(args: Args) -> CliResult {
         });
         rows.push(row);
     }
+    skipped.sort_by_key(|(i, _)| *i);
+    let skipped: Vec<String> = skipped.into_iter().map(|(_, s)| s).collect();
     if !skipped.is_empty() {
         if args.strict || rows.is_empty() {
-            return Err(skipped.swap_remove(0));
+            return Err(skipped[0].clone());
         }
         // One line each, up to a screenful; a file of 100 000 bad tracks gets a count.
         for s in skipped.iter().take(MAX_WARNINGS) {

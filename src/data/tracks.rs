@@ -4,7 +4,8 @@
 //! `d1_mm,d2_mm`; optional `phase` (`pre`/`post`; when absent the split is found from the
 //! tracks), optional spins measured from markers `w1z_rad_s,w2z_rad_s` (before) and
 //! `w1z_post_rad_s,w2z_post_rad_s` (after), constant within a collision. An empty spin cell
-//! (a sphere whose spin was not measured) is read as 0.
+//! (a sphere whose spin was not measured) is read as NaN: the kinematics takes it as 0 and says
+//! so ([`crate::kinematics::batch`]).
 
 use super::{CsvOut, DataError, Table, fmt_num, shown};
 use crate::kinematics::Frame;
@@ -127,7 +128,7 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
             }
         }
         if have_spins && acc.track.spins_rad_s.is_none() {
-            acc.track.spins_rad_s = Some(spins.map(|w| if w.is_nan() { 0.0 } else { w }));
+            acc.track.spins_rad_s = Some(spins);
         }
         if !acc.times.insert((t + 0.0).to_bits()) {
             return Err(table.cell_error(
@@ -260,14 +261,18 @@ mod tests {
         assert_eq!(again[0].split, t[0].split);
         assert_eq!(again[0].spins_rad_s, t[0].spins_rad_s);
         assert_eq!(again[0].d1_m, t[0].d1_m);
-        // An unmeasured spin is written empty and read back as 0; an id with a comma is quoted.
+        // An unmeasured spin is written empty and read back as NaN; an id with a comma is quoted.
         t[0].spins_rad_s = Some([1.0, f64::NAN, 3.0, -4.5]);
         t[0].id = "a,b".into();
         let text = write_tracks(&t);
         assert!(text.contains("\"a,b\""), "{text}");
         let again = parse_tracks(&Table::parse("u.csv", &text).unwrap()).unwrap();
         assert_eq!(again[0].id, "a,b");
-        assert_eq!(again[0].spins_rad_s, Some([1.0, 0.0, 3.0, -4.5]));
+        let w = again[0].spins_rad_s.unwrap();
+        assert!(
+            w[1].is_nan() && [w[0], w[2], w[3]] == [1.0, 3.0, -4.5],
+            "{w:?}"
+        );
     }
 
     #[test]

@@ -31,6 +31,7 @@ use crate::error::{Error, Result};
 use crate::models::walton::{self, Body, Measured, State};
 use nalgebra::{DMatrix, DVector, Vector2, Vector3};
 
+pub mod batch;
 mod instant;
 use instant::{collision_time, normal_restitution, propagate};
 

@@ -1,0 +1,72 @@
+//! `kinematics` on tracks with spins: an empty spin cell (a sphere whose spin `track` could not
+//! measure) is taken as 0 and the command says so, naming the collision and the cell; beta
+//! changes with the spin, so the number printed depends on it and the warning is not cosmetic.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn bin() -> PathBuf {
+    PathBuf::from(env!("CARGO_BIN_EXE_restitution"))
+}
+
+fn tracks() -> String {
+    std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/reports/track/tracks.csv"
+    ))
+    .unwrap()
+}
+
+/// Runs `kinematics` on `text` (CSV output) and returns (stdout, stderr).
+fn kinematics(tag: &str, text: &str) -> (String, String) {
+    let dir = std::env::temp_dir().join(format!("restitution-kin-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("tracks.csv");
+    std::fs::write(&path, text).unwrap();
+    let o = Command::new(bin())
+        .args(["kinematics", path.to_str().unwrap(), "--material", "nylon"])
+        .args(["--format", "csv"])
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    (
+        String::from_utf8(o.stdout).unwrap(),
+        String::from_utf8(o.stderr).unwrap(),
+    )
+}
+
+/// The text with column `name` emptied in every row.
+fn blank(text: &str, name: &str) -> String {
+    let mut lines = text.lines();
+    let head = lines.next().unwrap();
+    let j = head.split(',').position(|c| c == name).unwrap();
+    let mut out = vec![head.to_string()];
+    for l in lines {
+        let mut f: Vec<&str> = l.split(',').collect();
+        f[j] = "";
+        out.push(f.join(","));
+    }
+    out.join("\n") + "\n"
+}
+
+fn beta(csv: &str) -> String {
+    let mut lines = csv.lines().filter(|l| !l.starts_with('#'));
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let j = head.iter().position(|c| *c == "beta").unwrap();
+    lines.next().unwrap().split(',').nth(j).unwrap().to_string()
+}
+
+#[test]
+fn an_unmeasured_spin_is_named_not_silently_zero() {
+    let full = tracks();
+    let (out_full, err_full) = kinematics("full", &full);
+    assert!(!err_full.contains("not measured"), "{err_full}");
+    let (out_blank, err_blank) = kinematics("blank", &blank(&full, "w2z_post_rad_s"));
+    assert!(
+        err_blank.contains("collision 'shot_7': w2z_post_rad_s not measured (empty): taken as 0"),
+        "{err_blank}"
+    );
+    // And it matters: sphere 2's post-collision spin enters beta.
+    assert_ne!(beta(&out_full), beta(&out_blank));
+}
