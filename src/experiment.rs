@@ -278,6 +278,20 @@ pub fn simulate(
             .frames_for(vpost[0].norm().max(vpost[1].norm()), rng);
         let (frames, split) = scene.film(&spec.camera, n_pre, n_post, rng);
         let wpost = [post.state.sphere.spin_rad_s.z, b2.spin_rad_s.z];
+        // At absurd speeds (1e300 m/s) the filmed positions overflow, and an absurdly small
+        // sphere (1e-80 mm) spins infinitely fast after an oblique impact: an error naming the
+        // collision's speed, not NaN or inf in the tracks.
+        if frames
+            .iter()
+            .any(|f| !f.r1_m.iter().chain(&f.r2_m).all(|x| x.is_finite()))
+            || !wpost.iter().all(|w| w.is_finite())
+        {
+            return Err(Error::InvalidParameter {
+                name: "normal speed (m/s) of a collision whose positions or spins overflow",
+                value: v_n,
+                expected: "a collision whose filmed positions and spins stay finite",
+            });
+        }
         let spins = [w[0], w[1], wpost[0], wpost[1]].map(|x| x + spin_noise.sample(rng));
         out.push(Simulated {
             id: format!("c{}", i + 1),

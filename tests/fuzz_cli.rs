@@ -101,6 +101,34 @@ fn seeded_bench_flags() {
     seeded(Command_::Bench, 8, 0);
 }
 
+/// Cases of the larger runs (`--cases 2000`, seeds 1-3) that broke the rules before their fixes:
+/// `inf` in a fit's warning (a gap with no bound; a contradicted certificate with no cell),
+/// NaN positions and inf spins in `simulate` tracks (1e300 m/s, a 1e-80 mm sphere), `predict`
+/// printing inf or naming no flag, and `walton fit` on 100 000 rows near the limit.
+#[test]
+fn cases_the_larger_runs_found() {
+    let base = Sheet::parse(&fig7());
+    let found: [(Command_, u64, u64); 12] = [
+        (Command_::Fit, 2, 985),
+        (Command_::Fit, 3, 1646),
+        (Command_::Fit, 3, 1980),
+        (Command_::Simulate, 2, 130),
+        (Command_::Simulate, 3, 1762),
+        (Command_::Walton, 2, 484),
+        (Command_::Predict, 1, 308),
+        (Command_::Predict, 1, 513),
+        (Command_::Predict, 1, 632),
+        (Command_::Predict, 1, 788),
+        (Command_::Predict, 1, 1305),
+        (Command_::Predict, 1, 1616),
+    ];
+    let cases: Vec<Case> = found
+        .iter()
+        .map(|&(c, seed, i)| case_of(c, seed, i, &base, true))
+        .collect();
+    assert_clean(&run_all("found", &cases));
+}
+
 fn fig7_rows(n: usize, error_column: Option<(&str, &str)>) -> Vec<u8> {
     let base = Sheet::parse(&fig7());
     let mut s = base.clone();

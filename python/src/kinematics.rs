@@ -8,6 +8,7 @@
 use crate::{Failure, Outcome, Source, run_detached};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use restitution::data::fmt_num;
 use restitution::data::tracks::parse_tracks;
 use restitution::experiment::Camera;
 use restitution::kinematics::batch::{BatchOptions, CollisionInput, measure_batch};
@@ -86,7 +87,8 @@ fn kinematics<'py>(
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(Failure::Input(format!(
-                    "{arg} = {v}: expected a number > 0"
+                    "{arg} = {}: expected a number > 0",
+                    fmt_num(v)
                 )));
             }
         }
@@ -99,7 +101,8 @@ fn kinematics<'py>(
             Some(p) if p.is_finite() && p > 0.0 => p,
             Some(p) => {
                 return Err(Failure::Input(format!(
-                    "subpixel_m = {p}: expected a size > 0 (m)"
+                    "subpixel_m = {}: expected a size > 0 (m)",
+                    fmt_num(p)
                 )));
             }
             None => Camera {

@@ -29,7 +29,8 @@ pub(crate) fn contact_end(s: &str) -> Outcome<ContactEnd> {
 fn method(name: &str, tol: f64) -> Outcome<(VmMethod, OdeSettings)> {
     if !(tol.is_finite() && tol > 0.0 && tol < 1.0) {
         return Err(Failure::Input(format!(
-            "tol = {tol}: expected a number in (0, 1)"
+            "tol = {}: expected a number in (0, 1)",
+            fmt_num(tol)
         )));
     }
     let ode = match name {
@@ -47,7 +48,10 @@ fn method(name: &str, tol: f64) -> Outcome<(VmMethod, OdeSettings)> {
 
 /// The error for element `i` of an input array.
 fn bad(name: &str, i: usize, value: f64, expected: &str) -> Failure {
-    Failure::Input(format!("{name}[{i}] = {value}: expected {expected}"))
+    Failure::Input(format!(
+        "{name}[{i}] = {}: expected {expected}",
+        fmt_num(value)
+    ))
 }
 
 /// Every value finite and accepted by `ok`, else an error naming the first bad one.
@@ -195,7 +199,8 @@ impl Geometry {
         };
         if !(d_mm.is_finite() && d_mm > 0.0) {
             return Err(Failure::Input(format!(
-                "d_mm = {d_mm}: expected a diameter > 0 (mm)"
+                "d_mm = {}: expected a diameter > 0 (mm)",
+                fmt_num(d_mm)
             )));
         }
         // Named as the command line names it (`--d-mm 1e-300: ...`), in Python's words.

@@ -292,12 +292,18 @@ pub fn run(a: Args) -> CliResult {
         }
         (None, Some(mu)) => {
             if !(mu.is_finite() && mu >= 0.0) {
-                return Err(format!("--mu0 {mu}: expected a finite number >= 0"));
+                return Err(format!(
+                    "--mu0 {}: expected a finite number >= 0",
+                    fmt_num(mu)
+                ));
             }
             if let Some(b) = a.beta0
                 && !(-1.0..=1.0).contains(&b)
             {
-                return Err(format!("--beta0 {b}: expected a number in [-1, 1]"));
+                return Err(format!(
+                    "--beta0 {}: expected a number in [-1, 1]",
+                    fmt_num(b)
+                ));
             }
             Some(Friction {
                 mu0: mu,

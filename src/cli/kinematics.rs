@@ -172,7 +172,7 @@ pub fn run(args: Args) -> CliResult {
         ("--inertia-k", args.inertia_k),
     ] {
         if !(v.is_finite() && v > 0.0) {
-            return Err(format!("{flag} {v}: expected a number > 0"));
+            return Err(format!("{flag} {}: expected a number > 0", fmt_num(v)));
         }
     }
     if args.pixels_x == 0 {
@@ -180,7 +180,12 @@ pub fn run(args: Args) -> CliResult {
     }
     let subpixel_m = match args.subpixel_m {
         Some(p) if p.is_finite() && p > 0.0 => p,
-        Some(p) => return Err(format!("--subpixel-m {p}: expected a size > 0 (m)")),
+        Some(p) => {
+            return Err(format!(
+                "--subpixel-m {}: expected a size > 0 (m)",
+                fmt_num(p)
+            ));
+        }
         None => args.fov_m / args.pixels_x as f64 / args.subpixel_expansion,
     };
     let eq8 = Eq8Inputs {

@@ -99,7 +99,10 @@ fn flagged(f: predict::Failure) -> String {
 
 pub fn run(args: Args) -> CliResult {
     if !(args.tol.is_finite() && args.tol > 0.0 && args.tol < 1.0) {
-        return Err(format!("--tol {}: expected a number in (0, 1)", args.tol));
+        return Err(format!(
+            "--tol {}: expected a number in (0, 1)",
+            fmt_num(args.tol)
+        ));
     }
     let ode = match args.method {
         MethodArg::Dop853 => OdeSettings::with_integrator(Integrator::Dop853, args.tol),
@@ -156,7 +159,10 @@ pub fn run(args: Args) -> CliResult {
 
 fn check_all(flag: &str, values: &[f64], ok: impl Fn(f64) -> bool, expected: &str) -> CliResult {
     match values.iter().find(|v| !(v.is_finite() && ok(**v))) {
-        Some(bad) => Err(format!("{flag} value {bad}: expected {expected}")),
+        Some(bad) => Err(format!(
+            "{flag} value {}: expected {expected}",
+            fmt_num(*bad)
+        )),
         None => Ok(()),
     }
 }
@@ -165,11 +171,11 @@ fn contact_from(args: &Args) -> Result<Contact, String> {
     let material = args.material.resolve()?;
     let d_mm = args.d_mm.ok_or("--d-mm is needed with --v-m-s")?;
     let sphere = Sphere::new(d_mm * 1e-3, material)
-        .map_err(|_| format!("--d-mm {d_mm}: expected a diameter > 0"))?;
+        .map_err(|_| format!("--d-mm {}: expected a diameter > 0", fmt_num(d_mm)))?;
     let pair = match (args.d2_mm, args.wall) {
         (Some(d2), _) => {
             let s2 = Sphere::new(d2 * 1e-3, material)
-                .map_err(|_| format!("--d2-mm {d2}: expected a diameter > 0"))?;
+                .map_err(|_| format!("--d2-mm {}: expected a diameter > 0", fmt_num(d2)))?;
             Pair::unequal(sphere, s2)
         }
         (None, true) => Pair::on_wall(sphere, material),

@@ -134,7 +134,7 @@ fn check(flag: &str, v: f64, ok: bool, expected: &str) -> CliResult {
     if v.is_finite() && ok {
         Ok(())
     } else {
-        Err(format!("{flag} {v}: expected {expected}"))
+        Err(format!("{flag} {}: expected {expected}", fmt_num(v)))
     }
 }
 
@@ -251,18 +251,19 @@ pub fn run(args: Args) -> CliResult {
         ..ExperimentSpec::paper()
     };
     let s1 = restitution::contact::Sphere::new(spec.d1_m, material)
-        .map_err(|e| format!("--d-mm {}: {e}", args.d_mm))?;
+        .map_err(|e| format!("--d-mm {}: {e}", fmt_num(args.d_mm)))?;
     let s2 = restitution::contact::Sphere::new(spec.d2_m, material)
-        .map_err(|e| format!("--d2-mm {d2_mm}: {e}"))?;
+        .map_err(|e| format!("--d2-mm {}: {e}", fmt_num(d2_mm)))?;
     // What a failure of the simulation is due to: the flags that set the physics.
     let context = format!(
-        "the virtual experiment failed with --d-mm {} --d2-mm {d2_mm} --model {} --eta {} --sigma-y-pa {} --v-n-m-s {},{}",
-        args.d_mm,
+        "the virtual experiment failed with --d-mm {} --d2-mm {} --model {} --eta {} --sigma-y-pa {} --v-n-m-s {},{}",
+        fmt_num(args.d_mm),
+        fmt_num(d2_mm),
         args.model.name(),
-        args.eta,
-        args.sigma_y_pa,
-        args.v_n_m_s[0],
-        args.v_n_m_s[1]
+        fmt_num(args.eta),
+        fmt_num(args.sigma_y_pa),
+        fmt_num(args.v_n_m_s[0]),
+        fmt_num(args.v_n_m_s[1])
     );
     let contact = Pair::unequal(s1, s2).contact();
     let params: Vec<f64> = match args.model {

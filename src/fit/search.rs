@@ -377,23 +377,33 @@ fn run<L: Landscape>(
         0.0
     };
     let mut certified = cert.reasons.is_empty() && gap <= tau * (1.0 + 1e-9);
-    // The cell holding the reported point was never dropped, so some bound is at most the
-    // point's chi2; anything else means a bound was wrong (rounding allowed: 1e-9 relative).
+    // The cell holding the reported point has a bound at most the point's chi2 and is kept
+    // (cells are discarded only when their bound exceeds U); anything else means a bound was
+    // wrong (rounding allowed: 1e-9 relative).
     let lowest_any = cert.lowest.min(cert.lowest_fine);
     if !(lowest_any <= best.chi2 + 1e-9 * best.chi2.abs().max(1.0)) {
         certified = false;
+        // With no cell kept the lowest bound is +inf: said in words, never printed as a number.
+        let bound = if lowest_any.is_finite() {
+            format!("lowest bound {}", show(lowest_any + obj.chi2_offset))
+        } else {
+            "no cell's bound at or below it".into()
+        };
         warnings.push(format!(
-            "the global search's lower bounds were contradicted (bound {}, point {}): the \
+            "the global search's lower bounds were contradicted ({bound}, point {}): the \
              certificate is void",
-            show(lowest_any + obj.chi2_offset),
             show(best.chi2 + obj.chi2_offset)
         ));
     }
+    // The gap is +inf when no bound is known at all: said in words, never printed as a number.
+    let below = if gap.is_finite() {
+        format!("a chi2 up to {} below the reported one", show(gap))
+    } else {
+        "any lower chi2".to_string()
+    };
     for why in &cert.reasons {
         warnings.push(format!(
-            "global minimum not certified: {why}; a chi2 up to {} below the reported one \
-             cannot be excluded",
-            show(gap)
+            "global minimum not certified: {why}; {below} cannot be excluded"
         ));
     }
     if cert.reasons.is_empty() && gap > tau * (1.0 + 1e-9) {

@@ -186,10 +186,12 @@ fn run_fit(a: FitArgs) -> CliResult {
             .collect::<Vec<_>>()
             .join(" "),
     };
+    // Built once when both stdout and --out want it (34 MB for 100 000 collisions).
+    let json = (matches!(a.format, Format::Json) || a.out.is_some()).then(|| to_json(&fit, &ctx));
     let text = match a.format {
         Format::Table => render_table(&fit, &ctx),
         Format::Csv => render_params_csv(&fit),
-        Format::Json => to_json(&fit, &ctx),
+        Format::Json => json.clone().expect("built for --format json"),
     };
     if let Some(dir) = &a.out {
         std::fs::create_dir_all(dir)
@@ -205,7 +207,10 @@ fn run_fit(a: FitArgs) -> CliResult {
                 render_markdown(&fit, &ctx).into_bytes(),
             ),
             (dir.join("walton.csv"), render_params_csv(&fit).into_bytes()),
-            (dir.join("walton.json"), to_json(&fit, &ctx).into_bytes()),
+            (
+                dir.join("walton.json"),
+                json.expect("built for --out").into_bytes(),
+            ),
             (
                 dir.join("walton_collisions.csv"),
                 render_collisions_csv(&fit, &ctx).into_bytes(),
