@@ -4,9 +4,9 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use restitution::contact::Material;
-use restitution::fit::input::read_fit_csv;
-use restitution::fit::report::{self, ReportContext};
-use restitution::fit::report_text;
+use restitution::data::fit_input::read_fit_csv;
+use restitution::data::report::fit::{self as report, ReportContext};
+use restitution::data::report::fit_text as report_text;
 use restitution::fit::{FitOptions, ModelKind, fit, fit_all};
 use restitution::models::viscoelastic::{ContactEnd, OdeSettings, VmMethod};
 use restitution::plot::fit::{fig7_svg, residuals_svg};

@@ -513,7 +513,7 @@ fn rk4_in_the_unstable_tail_fails_loudly() {
 fn fit_accuracy_picks_the_cheapest_method_that_meets_the_rule() {
     use restitution::bench::fit_accuracy::{SIGMA_FRACTION, fit_accuracy};
     use restitution::contact::Material;
-    use restitution::fit::input::parse_fit_csv;
+    use restitution::data::fit_input::parse_fit_csv;
     use restitution::models::viscoelastic::VmMethod;
     let input = parse_fit_csv(
         "data/fig7_nylon.csv",

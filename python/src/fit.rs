@@ -3,9 +3,9 @@
 
 use crate::{Failure, Outcome, Source, run_detached};
 use pyo3::prelude::*;
-use restitution::fit::input::{FitInput, parse_fit_csv, read_fit_csv};
-use restitution::fit::report::{self, ReportContext};
-use restitution::fit::report_text;
+use restitution::data::fit_input::{FitInput, parse_fit_csv, read_fit_csv};
+use restitution::data::report::fit::{self as report, ReportContext};
+use restitution::data::report::fit_text as report_text;
 use restitution::fit::{FitOptions, FitSet, ModelKind, fit_all};
 use restitution::models::viscoelastic::{ContactEnd, OdeSettings, VmMethod};
 use restitution::plot::fit::{fig7_svg, residuals_svg};

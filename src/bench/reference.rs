@@ -122,7 +122,7 @@ fn law_by_logs(kappa: f64, rule: ContactEnd) -> f64 {
 
 /// e and 1 - e at any kappa >= 0: the large-kappa laws where they hold to far below the map's
 /// threshold (overlap kappa >= 10: 3.5e-36; force kappa > 1e4: 4.8e-12), evaluated by
-/// [`law_by_logs`]; otherwise the ODE at its tightest setting (checked against the fixture by
+/// `law_by_logs`; otherwise the ODE at its tightest setting (checked against the fixture by
 /// [`check_ode_reference`]).
 pub fn vm_dense_reference(kappa: f64, rule: ContactEnd) -> Result<(f64, f64, RefSource)> {
     let law_from = match rule {

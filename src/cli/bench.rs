@@ -16,8 +16,8 @@
 use super::CliResult;
 use restitution::bench::{self, BenchConfig};
 use restitution::contact::Material;
+use restitution::data::fit_input::parse_fit_csv;
 use restitution::data::write_all_atomic;
-use restitution::fit::input::parse_fit_csv;
 use restitution::plot;
 use std::path::PathBuf;
 

@@ -14,10 +14,10 @@
 //! none. `--exact` integrates the ODE for every point instead of using the master curve.
 
 use super::{CliResult, Format, MaterialArgs};
+use restitution::data::fit_input::read_fit_csv;
+use restitution::data::report::fit::{self as report, ReportContext};
+use restitution::data::report::fit_text as report_text;
 use restitution::data::write_all_atomic;
-use restitution::fit::input::read_fit_csv;
-use restitution::fit::report::{self, ReportContext};
-use restitution::fit::report_text;
 use restitution::fit::{FitOptions, ModelKind, fit_all};
 use restitution::models::viscoelastic::{ContactEnd, OdeSettings, VmMethod};
 use restitution::plot::fit::{fig7_svg, residuals_svg};

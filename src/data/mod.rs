@@ -16,6 +16,7 @@ pub mod fit_input;
 pub mod frames;
 pub mod images;
 pub mod png;
+pub mod report;
 mod table;
 pub mod tracks;
 pub mod walton;

@@ -188,7 +188,7 @@ const ETA_SCAN: usize = 61;
 
 /// The closest viscoelastic law; see [`ViscoelasticFit`].
 ///
-/// **Method**: each objective is scanned on [`ETA_SCAN`] values of ln eta spanning the dampings
+/// **Method**: each objective is scanned on `ETA_SCAN` values of ln eta spanning the dampings
 /// for which kappa runs from 1e-7 (e = 1 - 1e-7) to 30 (e ~ 1e-7) somewhere in the scene (capped
 /// at kappa = 100 everywhere), then
 /// polished by Brent's method (argmin) between the neighbours of the best grid point. The

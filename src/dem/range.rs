@@ -148,7 +148,7 @@ const SAMPLES: usize = 400;
 
 /// The largest value of f on the range and where it is, in m/s.
 ///
-/// **Method**: f at [`SAMPLES`] speeds evenly spaced in ln v (ends included), then golden-section
+/// **Method**: f at `SAMPLES` speeds evenly spaced in ln v (ends included), then golden-section
 /// search for the maximum between the neighbours of the best sample (at most 100 steps, to a
 /// relative width of 1e-12 in ln v). Finds the global maximum whenever f is unimodal between
 /// neighbouring samples, which holds for the smooth, monotone or single-kinked curves of the

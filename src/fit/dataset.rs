@@ -1,7 +1,7 @@
 //! Measured coefficients of restitution, ready for fitting: one [`Observation`] per collision,
 //! with the Hertz contact of its pair derived once (docs/physics.md §1).
 //!
-//! Pure data: no file reading here (that is [`super::input`]), so that the kinematics pipeline and
+//! Pure data: no file reading here (that is the I/O layer's `data::fit_input`), so that the kinematics pipeline and
 //! the benchmarks can build a [`FitData`] from numbers they already hold.
 
 use crate::contact::{Contact, Material, Pair, Sphere};

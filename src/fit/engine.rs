@@ -213,10 +213,10 @@ fn check_disjoint(
                 "the 95% region of {} has a part outside the interval: chi2 = {} (within the \
                  threshold {}) at {} = {}",
                 spec.key,
-                crate::data::fmt_num(*c + obj.chi2_offset),
-                crate::data::fmt_num(threshold),
+                crate::error::Num(*c + obj.chi2_offset),
+                crate::error::Num(threshold),
                 spec.key,
-                crate::data::fmt_num(v)
+                crate::error::Num(v)
             ));
         }
     }
@@ -340,7 +340,7 @@ fn summarise(
             notes.push(format!(
                 "{} ended at the edge of its search range ({}{unit})",
                 spec.key,
-                crate::data::fmt_num(phys[j]),
+                crate::error::Num(phys[j]),
             ));
         }
     }
@@ -365,7 +365,7 @@ fn summarise(
             "{} rows share {} distinct (d, d2, v_n) points: fitted as those points with their              weighted mean e (exact: chi2 differs by the constant {})",
             n,
             m.data.len(),
-            crate::data::fmt_num(m.chi2_offset)
+            crate::error::Num(m.chi2_offset)
         ));
     }
     let (kf, nf) = (k as f64, n as f64);

@@ -123,7 +123,7 @@ fn profile_point(
 }
 
 /// Brent's method on the profile along each axis of a two-parameter model in turn (see
-/// [`profile_point`]), over +-[`VALLEY_REACH`] standard errors, then Levenberg-Marquardt; repeated
+/// `profile_point`), over +-[`VALLEY_REACH`] standard errors, then Levenberg-Marquardt; repeated
 /// while it gains.
 pub fn polish_profiles(obj: &Objective, start: Found) -> Result<Found> {
     let mut best = start;

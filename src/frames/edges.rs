@@ -40,7 +40,7 @@ pub fn bilinear(img: &GrayImage, u: f64, v: f64) -> Option<f64> {
     Some(top * (1.0 - ty) + bot * ty)
 }
 
-/// Subpixel position of a sampled peak: given samples g[k-1], g[k], g[k+1] with g[k] the
+/// Subpixel position of a sampled peak: given samples `g[k-1], g[k], g[k+1]` with `g[k]` the
 /// largest, the offset of the maximum from k in samples, in [-0.5, 0.5]. Gaussian interpolation
 /// (a parabola through the logarithms; exact for a Gaussian peak, which a blurred edge's
 /// derivative is) when all three are positive, else a parabola through the values (exact for a

@@ -101,7 +101,7 @@ pub struct CollisionResult {
     pub track_frames: Vec<usize>,
     /// First post-collision row of `tracks`, when the phases could be separated.
     pub split: Option<usize>,
-    /// spins[sphere][phase] (phase 0: before, 1: after the collision).
+    /// `spins[sphere][phase]` (phase 0: before, 1: after the collision).
     pub spins: [[Spin; 2]; 2],
     pub warnings: Vec<String>,
 }

@@ -22,7 +22,7 @@ struct Curve {
 fn tick(v: &f64) -> String {
     let lead = *v / 10f64.powf(v.log10().floor());
     if [1.0, 2.0, 5.0].iter().any(|l| (lead - l).abs() < 1e-6) {
-        crate::data::fmt_num(*v)
+        crate::error::Num(*v).to_string()
     } else {
         String::new()
     }

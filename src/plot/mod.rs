@@ -1,4 +1,4 @@
-//! All figures, as SVG through plotters' SVG backend (no system fonts: text stays SVG <text>).
+//! All figures, as SVG through plotters' SVG backend (no system fonts: text stays SVG `<text>`).
 //! One submodule per figure family; they take plain numbers, never read files.
 //!
 //! plotters' SVG font sizes come out smaller than asked, so sizes here are chosen by looking at
@@ -24,6 +24,7 @@ pub fn colour(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
 
+#[cfg(feature = "io")]
 pub mod bench;
 /// Draws a chart's legend in the house style: a nearly opaque white box with a grey border, at
 /// `position`, labels at `font_px` (nominal; see the module note on SVG font sizes).

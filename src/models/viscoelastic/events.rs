@@ -1,13 +1,13 @@
 //! Event location on the integrated trajectory: the turning point, the force maximum and the
 //! force-rule end of contact, each a sign change of an event function of (x, p) bracketed by two
-//! accepted steps and refined by [`locate`].
+//! accepted steps and refined by `locate`.
 
 use super::ContactEnd;
 use super::ode::{Phase, Stage, State, Var, integrate, rhs, x_p};
 use super::settings::{Integrator, OdeSettings};
 use crate::error::{Error, IntegrationFailure, Num, Result};
 
-/// Iteration cap of [`locate`]. Newton converges in 3-6 steps and the Illinois fallback in
+/// Iteration cap of `locate`. Newton converges in 3-6 steps and the Illinois fallback in
 /// about 10-30 (measured on the bench's chart); 100 leaves a wide margin and bounds the cost of
 /// a pathological bracket at 100 short re-integrations.
 pub const LOCATE_MAX_ITERATIONS: usize = 100;

@@ -247,7 +247,7 @@ pub fn restitution_approx(
     }
 }
 
-/// Taylor coefficients t_0..t_{N-1} of num(x)/den(x) (den[0] != 0), by series division.
+/// Taylor coefficients t_0..t_{N-1} of num(x)/den(x) (`den[0] != 0`), by series division.
 pub fn taylor_of_ratio<const N: usize>(num: &[f64], den: &[f64]) -> [f64; N] {
     let mut t = [0.0; N];
     for j in 0..N {

@@ -2,12 +2,12 @@
 //! rounded to the precision of its error (two significant digits); the fit's warnings are listed
 //! under the tables (`warnings: none` when there are none), so a reader cannot miss them.
 
-use super::compare::PREFERENCE_RULE;
-use super::engine::FitSet;
-use super::models::{ModelKind, POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S};
-use super::report::{ReportContext, vm_method_name};
-use super::result::{ParamEstimate, ParamStatus};
+use super::fit::{ReportContext, vm_method_name};
 use crate::data::fmt_num;
+use crate::fit::compare::PREFERENCE_RULE;
+use crate::fit::engine::FitSet;
+use crate::fit::models::{ModelKind, POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S};
+use crate::fit::result::{ParamEstimate, ParamStatus};
 
 /// Decimal exponent used to print a value (engineering style only outside [1e-3, 1e5)).
 fn exponent_of(x: f64) -> i32 {

@@ -1,13 +1,13 @@
 //! Renders fits as CSV and JSON (strings only; writing files is the caller's job), every number
-//! in shortest round-trip form; the human formats are in [`super::report_text`]. Each fit carries
+//! in shortest round-trip form; the human formats are in [`super::fit_text`]. Each fit carries
 //! its `warnings` (what was lost: JSON list, CSV column) next to `converged`.
 
-use super::compare::PREFERENCE_RULE;
-use super::dataset::FitData;
-use super::engine::FitSet;
-use super::models::{ModelKind, POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S};
-use super::result::{FitResult, ParamEstimate};
 use crate::data::fmt_num;
+use crate::fit::compare::PREFERENCE_RULE;
+use crate::fit::dataset::FitData;
+use crate::fit::engine::FitSet;
+use crate::fit::models::{ModelKind, POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S};
+use crate::fit::result::{FitResult, ParamEstimate};
 use crate::models::viscoelastic::{ContactEnd, VmMethod};
 use serde_json::{Map, Value, json};
 
@@ -17,7 +17,7 @@ pub struct ReportContext<'a> {
     /// The input file as the user named it.
     pub path: &'a str,
     pub data: &'a FitData,
-    /// Where the errors of e came from, in words (see [`super::input::ErrorSource::describe`]).
+    /// Where the errors of e came from, in words (see [`crate::data::fit_input::ErrorSource::describe`]).
     pub error_source: &'a str,
     pub rule: ContactEnd,
     pub vm_method: &'a VmMethod,
