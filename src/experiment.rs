@@ -7,7 +7,7 @@
 //! and films the result.
 
 use crate::contact::{Material, Sphere};
-use crate::error::{Error, Result};
+use crate::error::{Error, Num, Result};
 use crate::kinematics::{FitKind, Frame, measure_e};
 use crate::models::walton::{self, Body, ContactKind, State, WaltonParams};
 use nalgebra::{Vector2, Vector3};
@@ -323,6 +323,32 @@ pub struct StudyPoint {
     /// Mean and standard deviation of e_measured/e_true - 1 over the measured collisions.
     pub bias: f64,
     pub scatter: f64,
+}
+
+/// The normal speeds of the camera study, m/s: the paper's range and beyond.
+pub const STUDY_SPEEDS_M_S: [f64; 7] = [0.3, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0];
+
+/// The cameras of the study: `base`, twice its frame rate, four times its pixels, and both (five
+/// times the rate), each named "F fps / N px". A faster camera films the same time window in
+/// more frames (the field of view, not the frame count, limits a phase); with the frame count
+/// fixed it would see a shorter window and measure slopes worse, not better.
+pub fn study_cameras(base: Camera) -> Vec<(String, Camera)> {
+    let fps = |k: f64| Camera {
+        frames_per_s: base.frames_per_s * k,
+        frames_min: (base.frames_min as f64 * k).round() as usize,
+        frames_max: (base.frames_max as f64 * k).round() as usize,
+        ..base
+    };
+    let px = |k: u32, cam: Camera| Camera {
+        pixels_x: cam.pixels_x * k,
+        pixels_y: cam.pixels_y * k,
+        ..cam
+    };
+    let name = |cam: &Camera| format!("{} fps / {} px", Num(cam.frames_per_s), cam.pixels_x);
+    [base, fps(2.0), px(4, base), px(4, fps(5.0))]
+        .into_iter()
+        .map(|cam| (name(&cam), cam))
+        .collect()
 }
 
 /// Monte Carlo of the measurement chain: for each camera and normal speed, simulate

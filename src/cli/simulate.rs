@@ -20,9 +20,12 @@ use super::{CliResult, MaterialArgs};
 use rand::SeedableRng;
 use rand::rngs::StdRng;
 use restitution::contact::Pair;
+use restitution::data::report::camera_study::camera_study_csv;
 use restitution::data::tracks::{CollisionTrack, write_tracks};
 use restitution::data::{CsvOut, fmt_num, write_all_atomic};
-use restitution::experiment::{Camera, ExperimentSpec, camera_study, simulate};
+use restitution::experiment::{
+    Camera, ExperimentSpec, STUDY_SPEEDS_M_S, camera_study, simulate, study_cameras,
+};
 use restitution::fit::models::{ModelKind, predict_e};
 use restitution::models::viscoelastic::{ContactEnd, VmMethod};
 use restitution::models::walton::Target;
@@ -409,75 +412,10 @@ fn study(
     rng: &mut StdRng,
 ) -> CliResult {
     let c = spec.camera;
-    // A faster camera films the same time window in more frames (the field of view, not the frame
-    // count, limits a phase); with the frame count fixed it would see a shorter window and
-    // measure slopes worse, not better.
-    let fps = |k: f64| Camera {
-        frames_per_s: c.frames_per_s * k,
-        frames_min: (c.frames_min as f64 * k).round() as usize,
-        frames_max: (c.frames_max as f64 * k).round() as usize,
-        ..c
-    };
-    let px = |k: u32, cam: Camera| Camera {
-        pixels_x: cam.pixels_x * k,
-        pixels_y: cam.pixels_y * k,
-        ..cam
-    };
-    let cameras = vec![
-        (
-            format!("{} fps / {} px", fmt_num(c.frames_per_s), c.pixels_x),
-            c,
-        ),
-        (
-            format!("{} fps / {} px", fmt_num(2.0 * c.frames_per_s), c.pixels_x),
-            fps(2.0),
-        ),
-        (
-            format!("{} fps / {} px", fmt_num(c.frames_per_s), 4 * c.pixels_x),
-            px(4, c),
-        ),
-        (
-            format!(
-                "{} fps / {} px",
-                fmt_num(5.0 * c.frames_per_s),
-                4 * c.pixels_x
-            ),
-            px(4, fps(5.0)),
-        ),
-    ];
-    let speeds = [0.3, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0];
-    let points = camera_study(spec, &cameras, &speeds, args.study_n, e_of, rng)
+    let cameras = study_cameras(c);
+    let points = camera_study(spec, &cameras, &STUDY_SPEEDS_M_S, args.study_n, e_of, rng)
         .map_err(|e| e.to_string())?;
-    let mut csv = CsvOut::new();
-    csv.record([
-        "camera",
-        "fit",
-        "v_n_m_s",
-        "simulated",
-        "measured",
-        "bias",
-        "scatter",
-    ]);
-    for p in &points {
-        csv.record([
-            p.camera.to_string(),
-            p.fit.to_string(),
-            fmt_num(p.v_n_m_s),
-            p.simulated.to_string(),
-            p.measured.to_string(),
-            // No bias or scatter without measured collisions: left empty ("measured" says why).
-            if p.bias.is_finite() {
-                fmt_num(p.bias)
-            } else {
-                String::new()
-            },
-            if p.scatter.is_finite() {
-                fmt_num(p.scatter)
-            } else {
-                String::new()
-            },
-        ]);
-    }
+    let csv = camera_study_csv(&points);
     let title = format!(
         "Measured e against true e: {} mm {}, s = {} subpixels, {}-{} frames per phase at the base rate",
         fmt_num(args.d_mm),
@@ -490,10 +428,7 @@ fn study(
     std::fs::create_dir_all(&args.out)
         .map_err(|e| format!("{}: cannot create: {e}", args.out.display()))?;
     write_all_atomic(&[
-        (
-            args.out.join("camera_study.csv"),
-            csv.into_string().into_bytes(),
-        ),
+        (args.out.join("camera_study.csv"), csv.into_bytes()),
         (args.out.join("camera_study.svg"), svg.into_bytes()),
     ])
     .map_err(|e| format!("{}: cannot write: {e}", args.out.display()))?;
