@@ -3,6 +3,7 @@
 
 pub mod bnb;
 pub mod compare;
+pub mod covariance;
 pub mod dataset;
 pub mod engine;
 pub mod kinks;

@@ -41,6 +41,7 @@ pub mod circle;
 pub mod detect;
 pub mod edges;
 pub mod markers;
+pub mod morphology;
 pub mod render;
 pub mod segment;
 pub mod spin;
