@@ -11,8 +11,8 @@
 //!   document, as `restitution fit --format json` does; the minimum over REPEATS runs.
 
 use restitution::contact::Material;
-use restitution::fit::input::read_fit_csv;
-use restitution::fit::report::{self, ReportContext};
+use restitution::data::fit_input::read_fit_csv;
+use restitution::data::report::fit::{self as report, ReportContext};
 use restitution::fit::{FitOptions, ModelKind, fit_all};
 use restitution::models::viscoelastic::{ContactEnd, VmMethod, restitution as e_vm};
 use std::hint::black_box;
