@@ -34,8 +34,8 @@ use nalgebra::{Vector2, Vector3};
 pub mod batch;
 mod instant;
 mod polyfit;
-pub use polyfit::{PhaseFit, PolyFit};
 use instant::{collision_time, normal_restitution, propagate};
+pub use polyfit::{PhaseFit, PolyFit};
 
 /// Standard gravity, m/s^2.
 pub const G_STANDARD_M_S2: f64 = 9.80665;

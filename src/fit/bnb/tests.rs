@@ -1,0 +1,117 @@
+//! The known-answer tests of [`super`]'s branch and bound (see its module doc).
+
+use super::*;
+
+/// f(x, y) = g(x) + (y - 0.3)^2 with g having minima at x = -1 (value 0.5) and x = 2
+/// (value 0): both parts are monotone on each side of their minima, so the exact range of
+/// f over a cell is known and the bound below is exact.
+struct TwoWells {
+    x: Vec<f64>,
+    y: Vec<f64>,
+    /// Loosen the bound by the cell's widths (still valid, but it needs splitting).
+    loose: bool,
+}
+fn g(x: f64) -> f64 {
+    ((x + 1.0).powi(2) + 0.5).min((x - 2.0).powi(2))
+}
+fn lowest(f: impl Fn(f64) -> f64, a: f64, b: f64, minima: &[f64]) -> f64 {
+    let mut v = f(a).min(f(b));
+    for &m in minima {
+        if a <= m && m <= b {
+            v = v.min(f(m));
+        }
+    }
+    v
+}
+impl Landscape for TwoWells {
+    fn add_row(&mut self, axis: usize, t: f64) -> Result<(), String> {
+        if axis == 0 {
+            self.x.push(t)
+        } else {
+            self.y.push(t)
+        }
+        Ok(())
+    }
+    fn node(&self, r: [usize; 2]) -> f64 {
+        g(self.x[r[0]]) + (self.y[r[1]] - 0.3).powi(2)
+    }
+    fn bound(&self, lo: [usize; 2], hi: [usize; 2], _target: f64) -> Bound {
+        // g's minima and the kink where its two branches meet (x = 1/6, where the lower
+        // envelope has a local maximum) are the only interior extremes.
+        let gx = lowest(g, self.x[lo[0]], self.x[hi[0]], &[-1.0, 2.0]);
+        let gy = lowest(
+            |y| (y - 0.3f64).powi(2),
+            self.y[lo[1]],
+            self.y[hi[1]],
+            &[0.3],
+        );
+        let w = [self.x[hi[0]] - self.x[lo[0]], self.y[hi[1]] - self.y[lo[1]]];
+        let slack = if self.loose { w[0] + w[1] } else { 0.0 };
+        Bound {
+            lb: gx + gy - slack,
+            loose: w,
+        }
+    }
+}
+
+#[test]
+fn certifies_two_wells_and_proposes_both() {
+    let land = TwoWells {
+        x: vec![],
+        y: vec![],
+        loose: false,
+    };
+    let limits = Limits {
+        max_cells: 100_000,
+        max_rows: 10_000,
+    };
+    let mut b = Bnb::new(land, [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], limits);
+    let tau = |_: f64| 1e-3;
+    let starts = b.initial_minima(f64::INFINITY, 1e-3);
+    // The starting grid (x step 1, y step 0.5) has its nodes at x = -1 and 2: both wells.
+    assert!(starts.iter().any(|c| c.t[0] == -1.0) && starts.iter().any(|c| c.t[0] == 2.0));
+    // With the true minimum 0 as U, everything is certified within tau.
+    b.refine(0.0, &tau);
+    let c = b.certificate(0.0);
+    assert!(
+        c.lowest >= -1e-3 && c.lowest <= 0.0 && c.reasons.is_empty() && c.fine_cells == 0,
+        "{c:?}"
+    );
+    // Candidates are proposed only around the global minimum (2, 0.3): each brackets it. The
+    // other well (0.5 above) is excluded by its bounds.
+    let c = b.candidates(0.0);
+    assert!(!c.is_empty());
+    for cand in &c {
+        let inside = (0..2)
+            .all(|k| cand.bracket_lo[k] <= [2.0, 0.3][k] && [2.0, 0.3][k] <= cand.bracket_hi[k]);
+        assert!(inside, "{cand:?}");
+    }
+    // Loose (first-order) bounds need splitting: certified with the budget, unresolved and
+    // reported as such with a budget of one cell.
+    let land = TwoWells {
+        x: vec![],
+        y: vec![],
+        loose: true,
+    };
+    let mut b = Bnb::new(land, [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], limits);
+    b.refine(0.0, &tau);
+    let c = b.certificate(0.0);
+    assert!(c.lowest >= -1e-3 && c.reasons.is_empty(), "{c:?}");
+    assert!(b.cells > 1000, "{}", b.cells);
+    let land = TwoWells {
+        x: vec![],
+        y: vec![],
+        loose: true,
+    };
+    let tight = Limits {
+        max_cells: 1,
+        max_rows: 10_000,
+    };
+    let mut b = Bnb::new(land, [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], tight);
+    b.refine(0.0, &tau);
+    let c = b.certificate(0.0);
+    assert!(
+        c.lowest < -1e-3 && c.reasons.iter().any(|w| w.contains("budget")),
+        "{c:?}"
+    );
+}

@@ -1,0 +1,245 @@
+//! The power law's landscape over its exponents (a, b) with A profiled out; the argument for its
+//! bound is in the parent module's documentation, its tests beside the separable models' there.
+
+use super::super::bnb::{Bound, Landscape};
+use super::super::models::{POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S, powerlaw_d_mm};
+use super::super::objective::Objective;
+
+/// Relative widening of the z ranges of the power law: a few rounding errors of exp and a
+/// product (1e-12 is 4500 ulp).
+const Z_SLACK: f64 = 1e-12;
+/// Newton or bisection steps per cell bound of the power law (each one pass over the points).
+const POWERLAW_BOUND_ITERS: usize = 30;
+
+/// The power law's landscape over (a, b), A profiled out.
+pub struct PowerLaw {
+    n: usize,
+    y: Vec<f64>,
+    w: Vec<f64>,
+    /// w / max(w), for sums that must not overflow.
+    w_scaled: Vec<f64>,
+    /// Centred -ln(d/d_ref) and ln(v/v_ref), and the centres.
+    c1: Vec<f64>,
+    c2: Vec<f64>,
+    m1: f64,
+    m2: f64,
+    a_range: (f64, f64),
+    /// Rows exp(-a c1_i) (axis 0) and exp(b c2_i) (axis 1), with their t.
+    rows: [Vec<f64>; 2],
+    t: [Vec<f64>; 2],
+    /// Sensitivity of chi2 to a and b: sqrt(sum w (c y)^2), with c the centred logarithm.
+    sens: [f64; 2],
+    /// How close to its minimum a cell bound is computed (efficiency only: any stop is valid).
+    pub bound_tol: f64,
+}
+
+impl PowerLaw {
+    pub fn new(obj: &Objective) -> Self {
+        let data = obj.ev.data;
+        let n = data.len();
+        let x1: Vec<f64> = data
+            .contacts
+            .iter()
+            .map(|c| (powerlaw_d_mm(c) / POWERLAW_D_REF_MM).ln())
+            .collect();
+        let x2: Vec<f64> = data
+            .obs
+            .iter()
+            .map(|o| (o.v_n_m_s / POWERLAW_V_REF_M_S).ln())
+            .collect();
+        let m1 = x1.iter().sum::<f64>() / n as f64;
+        let m2 = x2.iter().sum::<f64>() / n as f64;
+        let w: Vec<f64> = obj.inv_sigma.iter().map(|s| s * s).collect();
+        let wmax = w.iter().cloned().fold(0.0, f64::max);
+        PowerLaw {
+            n,
+            y: data.obs.iter().map(|o| 1.0 - o.e).collect(),
+            w_scaled: w.iter().map(|x| x / wmax).collect(),
+            sens: [
+                (0..n)
+                    .map(|i| w[i] * ((x1[i] - m1) * (1.0 - data.obs[i].e)).powi(2))
+                    .sum::<f64>()
+                    .sqrt(),
+                (0..n)
+                    .map(|i| w[i] * ((x2[i] - m2) * (1.0 - data.obs[i].e)).powi(2))
+                    .sum::<f64>()
+                    .sqrt(),
+            ],
+            w,
+            c1: x1.iter().map(|x| x - m1).collect(),
+            c2: x2.iter().map(|x| x - m2).collect(),
+            m1,
+            m2,
+            a_range: (obj.lower[0].exp(), obj.upper[0].exp()),
+            rows: [Vec::new(), Vec::new()],
+            t: [Vec::new(), Vec::new()],
+            bound_tol: 0.0,
+        }
+    }
+
+    fn row(&self, k: usize, r: usize) -> &[f64] {
+        &self.rows[k][r * self.n..(r + 1) * self.n]
+    }
+
+    /// ln of the factor between A and the centred amplitude: A_c = A exp(-a m1 + b m2).
+    fn shift(&self, a: f64, b: f64) -> f64 {
+        -a * self.m1 + b * self.m2
+    }
+
+    /// The exact minimum over A (in its box) at the node: (ln A, chi2).
+    pub fn profile(&self, r: [usize; 2]) -> (f64, f64) {
+        let (za, zb) = (self.row(0, r[0]), self.row(1, r[1]));
+        let (a, b) = (self.t[0][r[0]], self.t[1][r[1]]);
+        // Least squares in A_c with z and w scaled by their maxima (no overflow in the sums).
+        let zmax = (0..self.n).map(|i| za[i] * zb[i]).fold(0.0, f64::max);
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..self.n {
+            let z = za[i] * zb[i] / zmax;
+            let w = self.w_scaled[i];
+            num += w * z * self.y[i];
+            den += w * z * z;
+        }
+        let s = self.shift(a, b);
+        let (lo, hi) = (self.a_range.0 * s.exp(), self.a_range.1 * s.exp());
+        let ac = num / den / zmax;
+        let ac = if ac.is_nan() || ac < lo {
+            lo
+        } else if ac > hi {
+            hi
+        } else {
+            ac
+        };
+        let mut chi2 = 0.0;
+        for i in 0..self.n {
+            let d = ac * za[i] * zb[i] - self.y[i];
+            chi2 += self.w[i] * d * d;
+        }
+        (ac.ln() - s, chi2)
+    }
+
+    /// f(A), f'(A) and f''(A) (from the right) of the module doc. Branch-free (selects), so it
+    /// vectorises; every input is finite (rows are checked when they are made).
+    fn f_slope_curv(&self, zlo: &[f64], zhi: &[f64], a: f64) -> (f64, f64, f64) {
+        let (mut f, mut d, mut h) = (0.0, 0.0, 0.0);
+        for i in 0..self.n {
+            let w = self.w[i];
+            let u = a * zlo[i] - self.y[i];
+            let v = self.y[i] - a * zhi[i];
+            // At most one of u, v is positive (zlo <= zhi).
+            let pu = if u > 0.0 { u } else { 0.0 };
+            let pv = if v > 0.0 { v } else { 0.0 };
+            let cu = if u > 0.0 { zlo[i] } else { 0.0 };
+            let cv = if v > 0.0 { zhi[i] } else { 0.0 };
+            f += w * (pu * pu + pv * pv);
+            d += 2.0 * w * (zlo[i] * pu - zhi[i] * pv);
+            h += 2.0 * w * (cu * cu + cv * cv);
+        }
+        (f, d, h)
+    }
+}
+
+impl Landscape for PowerLaw {
+    fn add_row(&mut self, axis: usize, t: f64) -> Result<(), String> {
+        let c = if axis == 0 { &self.c1 } else { &self.c2 };
+        let sign = if axis == 0 { -1.0 } else { 1.0 };
+        let row: Vec<f64> = c.iter().map(|x| (sign * t * x).exp()).collect();
+        let bad = row.iter().any(|z| !z.is_finite());
+        self.rows[axis].extend(row);
+        self.t[axis].push(t);
+        if bad {
+            return Err(format!(
+                "the power law overflows at {} = {t}",
+                if axis == 0 { "a" } else { "b" }
+            ));
+        }
+        Ok(())
+    }
+
+    fn node(&self, r: [usize; 2]) -> f64 {
+        self.profile(r).1
+    }
+
+    fn bound(&self, lo: [usize; 2], hi: [usize; 2], target: f64) -> Bound {
+        let (za0, za1) = (self.row(0, lo[0]), self.row(0, hi[0]));
+        let (zb0, zb1) = (self.row(1, lo[1]), self.row(1, hi[1]));
+        let mut zlo = Vec::with_capacity(self.n);
+        let mut zhi = Vec::with_capacity(self.n);
+        for i in 0..self.n {
+            zlo.push(za0[i].min(za1[i]) * zb0[i].min(zb1[i]) * (1.0 - Z_SLACK));
+            zhi.push(za0[i].max(za1[i]) * zb0[i].max(zb1[i]) * (1.0 + Z_SLACK));
+        }
+        // The box of the centred amplitude over the cell: the shift is linear in a and b.
+        let (a0, a1) = (self.t[0][lo[0]], self.t[0][hi[0]]);
+        let (b0, b1) = (self.t[1][lo[1]], self.t[1][hi[1]]);
+        let shifts = [
+            self.shift(a0, b0),
+            self.shift(a1, b0),
+            self.shift(a0, b1),
+            self.shift(a1, b1),
+        ];
+        let smin = shifts.iter().cloned().fold(f64::INFINITY, f64::min);
+        let smax = shifts.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let (mut x1, mut x2) = (self.a_range.0 * smin.exp(), self.a_range.1 * smax.exp());
+        // How much each axis loosens the bound: its width times the model's sensitivity to it.
+        let wa = (a1 - a0) * self.sens[0];
+        let wb = (b1 - b0) * self.sens[1];
+        let loose = |_: f64| [wa * wa, wb * wb];
+        let (mut f1, mut d1, _) = self.f_slope_curv(&zlo, &zhi, x1);
+        if d1 >= 0.0 {
+            return Bound {
+                lb: f1,
+                loose: loose(x1),
+            };
+        }
+        let (mut f2, mut d2, _) = self.f_slope_curv(&zlo, &zhi, x2);
+        if d2 <= 0.0 {
+            return Bound {
+                lb: f2,
+                loose: loose(x2),
+            };
+        }
+        // f'(x1) < 0 < f'(x2): the tangents' crossing is a lower bound. Newton steps on the
+        // piecewise linear f' (exact on each piece) move the bracket in; bisection (geometric, A
+        // spans decades) when a step leaves it. Start from the least-squares A at the middle z.
+        let (mut num, mut den) = (0.0, 0.0);
+        for i in 0..self.n {
+            let z = 0.5 * (zlo[i] + zhi[i]);
+            num += self.w[i] * z * self.y[i];
+            den += self.w[i] * z * z;
+        }
+        let mut x = num / den;
+        let mut lb = f64::NEG_INFINITY;
+        for _ in 0..POWERLAW_BOUND_ITERS {
+            if !(x > x1 && x < x2) {
+                x = if x1 > 0.0 {
+                    (x1 * x2).sqrt()
+                } else {
+                    0.5 * (x1 + x2)
+                };
+            }
+            let (f, d, h) = self.f_slope_curv(&zlo, &zhi, x);
+            if d == 0.0 || f == 0.0 {
+                lb = f;
+                break;
+            }
+            if d < 0.0 {
+                (x1, f1, d1) = (x, f, d);
+            } else {
+                (x2, f2, d2) = (x, f, d);
+            }
+            let xc = (f2 - f1 + d1 * x1 - d2 * x2) / (d1 - d2);
+            lb = f1 + d1 * (xc - x1);
+            // Decided: the cell is excluded (lb above the target), or it holds a point below
+            // the target (so it will be split whatever the bound), or the bound is tight.
+            if lb >= target || f1.min(f2) < target || f1.min(f2) - lb <= self.bound_tol {
+                break;
+            }
+            x -= d / h;
+        }
+        // chi2 >= 0 always; a NaN bound (overflow) is passed on for the search to report.
+        Bound {
+            lb: if lb < 0.0 { 0.0 } else { lb },
+            loose: loose(0.5 * (x1 + x2)),
+        }
+    }
+}
