@@ -43,7 +43,8 @@ use crate::error::{Error, IntegrationFailure, Result};
 use crate::models::viscoelastic::ContactEnd;
 
 /// The exponent q of the dashpot alpha x^q x'.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, strum::IntoStaticStr)]
+#[strum(serialize_all = "lowercase")]
 pub enum Dashpot {
     /// q = 1/2: the viscoelastic model of Eqs. 9-10 (alpha = kappa).
     Viscoelastic,
@@ -69,10 +70,7 @@ impl Dashpot {
     }
 
     pub fn name(self) -> &'static str {
-        match self {
-            Dashpot::Viscoelastic => "viscoelastic",
-            Dashpot::Tsuji => "tsuji",
-        }
+        self.into()
     }
 }
 

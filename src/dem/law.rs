@@ -384,7 +384,8 @@ pub fn table(
 }
 
 /// The kinds of law, simplest first.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, strum::IntoStaticStr)]
+#[strum(serialize_all = "kebab-case")]
 pub enum LawKind {
     /// One e per pair, whatever the speed.
     ConstantE,
@@ -398,11 +399,7 @@ impl LawKind {
     pub const ALL: [LawKind; 3] = [LawKind::ConstantE, LawKind::Viscoelastic, LawKind::Table];
 
     pub fn name(self) -> &'static str {
-        match self {
-            LawKind::ConstantE => "constant-e",
-            LawKind::Viscoelastic => "viscoelastic",
-            LawKind::Table => "table",
-        }
+        self.into()
     }
 }
 

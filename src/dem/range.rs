@@ -47,7 +47,8 @@ impl SpeedRange {
 }
 
 /// How the speeds of a scene are distributed over its range, for the weighted means.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default, strum::IntoStaticStr)]
+#[strum(serialize_all = "kebab-case")]
 pub enum Weight {
     /// Uniform in ln v: every decade of speed counts the same (the default: granular flows span
     /// decades of collision speed and nothing singles out one of them).
@@ -59,10 +60,7 @@ pub enum Weight {
 
 impl Weight {
     pub fn name(self) -> &'static str {
-        match self {
-            Weight::LogUniform => "log-uniform",
-            Weight::Uniform => "uniform",
-        }
+        self.into()
     }
 
     fn to_u(self, v: f64) -> f64 {

@@ -65,7 +65,8 @@ const POW_EXP_V: ParamSpec = ParamSpec {
 };
 
 /// Which model to fit.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, strum::IntoStaticStr)]
+#[strum(serialize_all = "lowercase")]
 pub enum ModelKind {
     Vm,
     Pm,
@@ -84,13 +85,7 @@ impl ModelKind {
     ];
 
     pub fn name(self) -> &'static str {
-        match self {
-            ModelKind::Vm => "vm",
-            ModelKind::Pm => "pm",
-            ModelKind::Min => "min",
-            ModelKind::Product => "product",
-            ModelKind::PowerLaw => "powerlaw",
-        }
+        self.into()
     }
 
     /// The model's formula in words, for tables.

@@ -5,7 +5,8 @@
 use super::models::ModelKind;
 
 /// How well the data determine a parameter.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, strum::IntoStaticStr)]
+#[strum(serialize_all = "snake_case")]
 pub enum ParamStatus {
     /// A value with an error and a closed 95% interval.
     Estimate,
@@ -22,13 +23,7 @@ pub enum ParamStatus {
 
 impl ParamStatus {
     pub fn name(self) -> &'static str {
-        match self {
-            ParamStatus::Estimate => "estimate",
-            ParamStatus::LowerBound => "lower_bound",
-            ParamStatus::UpperBound => "upper_bound",
-            ParamStatus::Unconstrained => "unconstrained",
-            ParamStatus::IntervalLost => "interval_lost",
-        }
+        self.into()
     }
 
     /// Whether the parameter has a value (with errors) rather than a bound or nothing.

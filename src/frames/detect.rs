@@ -15,20 +15,19 @@ use super::markers::{Marker, find_markers};
 use super::segment::{Coarse, CoarseError, coarse};
 
 /// How a sphere's radius was treated in its fit.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, strum::IntoStaticStr)]
+#[strum(serialize_all = "snake_case")]
 pub enum RadiusMode {
     /// Fitted with the centre.
     Free,
     /// Held at a known value (short visible arc).
+    #[strum(serialize = "fixed_radius")]
     Fixed,
 }
 
 impl RadiusMode {
     pub fn name(self) -> &'static str {
-        match self {
-            RadiusMode::Free => "free",
-            RadiusMode::Fixed => "fixed_radius",
-        }
+        self.into()
     }
 }
 

@@ -8,7 +8,8 @@ use crate::dem::range::SpeedRange;
 use crate::dem::translate::{ConstantEInputs, Translation, constant_e_inputs};
 
 /// The engine family the user exports for.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, strum::IntoStaticStr)]
+#[strum(serialize_all = "kebab-case")]
 pub enum EngineKind {
     Lammps,
     ConstantE,
@@ -17,11 +18,7 @@ pub enum EngineKind {
 
 impl EngineKind {
     pub fn name(self) -> &'static str {
-        match self {
-            EngineKind::Lammps => "lammps",
-            EngineKind::ConstantE => "constant-e",
-            EngineKind::Table => "table",
-        }
+        self.into()
     }
 }
 
