@@ -1,4 +1,4 @@
-//! `walton_fit`: the calls of `restitution walton fit` (src/cli/walton.rs): read the collisions,
+//! `walton_fit`: the calls of `restitution walton fit` (src/cli/walton/): read the collisions,
 //! measure them, fit Walton's operator. The CLI's JSON document is built inside src/cli and is
 //! not reusable yet, so this returns the library's `WaltonFit` as a dict (same names where the
 //! two share a number).
