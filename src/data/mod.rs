@@ -76,6 +76,24 @@ pub fn fmt_num(x: f64) -> String {
     crate::error::Num(x).to_string()
 }
 
+/// A number for human eyes: 10 significant digits, exponent form when very small or large.
+pub fn readable(x: f64) -> String {
+    let a = x.abs();
+    if x == 0.0 || !x.is_finite() {
+        format!("{x}")
+    } else if (1e-3..1e7).contains(&a) {
+        let digits = (9 - a.log10().floor() as i32).max(0) as usize;
+        let s = format!("{x:.digits$}");
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    } else {
+        format!("{x:.9e}")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -27,14 +27,14 @@
 mod render;
 
 use super::{CliResult, Format, MaterialArgs};
-use render::{
-    Context, fig6_fit, fig6_points, render_collisions_csv, render_markdown, render_params_csv,
-    render_table, to_json,
+use render::{fig6_fit, fig6_points};
+use restitution::data::report::walton::{
+    Context, render_collisions_csv, render_markdown, render_params_csv, render_table, to_json,
 };
 use restitution::data::walton::{measure_records, read_collisions};
 use restitution::data::{Table, write_all_atomic};
 use restitution::fit::walton::{self as wfit, FitOptions, Weights};
-use restitution::models::walton::{K_HOMOGENEOUS, Target};
+use restitution::models::walton::K_HOMOGENEOUS;
 use restitution::plot::walton::fig6_svg;
 use std::path::PathBuf;
 
@@ -157,35 +157,12 @@ fn run_fit(a: FitArgs) -> CliResult {
     if !fit.converged {
         super::warn(format_args!("{}: {}", table.path, fit.message));
     }
-    let mut diameters_mm: Vec<f64> = Vec::new();
-    let mut walls = 0;
-    for r in &records {
-        let mut add = |d_m: f64| {
-            let d = d_m * 1e3;
-            if !diameters_mm.iter().any(|x| (x - d).abs() <= 1e-9 * d) {
-                diameters_mm.push(d);
-            }
-        };
-        add(r.pre.sphere.d_m);
-        match r.pre.target {
-            Target::Sphere(b) => add(b.d_m),
-            Target::Wall { .. } => walls += 1,
-        }
-    }
-    diameters_mm.sort_by(f64::total_cmp);
-    let ctx = Context {
-        path: table.path.clone(),
-        diameters_mm,
-        walls,
-        lines: records.iter().map(|r| r.line).collect(),
-        ids: records.iter().map(|r| r.id.clone()).collect(),
-        material,
-        command: std::iter::once("restitution".to_string())
-            .chain(std::env::args().skip(1))
-            .map(|s| if s.contains(' ') { format!("'{s}'") } else { s })
-            .collect::<Vec<_>>()
-            .join(" "),
-    };
+    let command = std::iter::once("restitution".to_string())
+        .chain(std::env::args().skip(1))
+        .map(|s| if s.contains(' ') { format!("'{s}'") } else { s })
+        .collect::<Vec<_>>()
+        .join(" ");
+    let ctx = Context::new(&table.path, &records, material, command);
     // Built once when both stdout and --out want it (34 MB for 100 000 collisions).
     let json = (matches!(a.format, Format::Json) || a.out.is_some()).then(|| to_json(&fit, &ctx));
     let text = match a.format {

@@ -4,3 +4,4 @@
 pub mod camera_study;
 pub mod fit;
 pub mod fit_text;
+pub mod walton;
