@@ -4,6 +4,7 @@ properties from tracked sphere centres (`restitution walton fit`, `restitution k
 from __future__ import annotations
 
 import copy
+import json
 import warnings
 import html
 from typing import Any, Dict, List, Optional
@@ -22,19 +23,18 @@ def _call(fn: Any, source: Source, **kwargs: Any) -> Dict[str, Any]:
 class WaltonResult:
     """The outcome of :func:`walton_fit`: the library's fit of Walton's operator.
 
-    ``to_dict()`` holds every number of the fit: ``e`` (weighted mean, stderr, bootstrap
-    ``ci95``, spread, min, max), ``beta0``, ``mu0``, ``slope``, ``psi_kink`` (value, stderr,
-    ci95, bound), ``gamma0_deg``, class counts, the impulse-ratio and momentum cross-checks,
-    ``converged``, ``message`` and per-collision columns under ``collisions``. Where a number
-    is also in ``restitution walton fit --format json`` it has the same name and value; the
-    layout is not yet that document (see the package README).
+    ``to_dict()`` is exactly the document of ``restitution walton fit --format json`` (built by
+    the same library function): ``e`` (weighted mean, stderr, bootstrap ``ci95``, spread, min,
+    max), ``beta0``, ``mu0``, ``slope``, ``psi_kink`` (value, stderr, ci95, bound),
+    ``gamma0_deg``, ``classes``, the impulse-ratio and momentum cross-checks, ``converged``,
+    ``message`` and one record per collision under ``collisions``.
     """
 
-    def __init__(self, doc: Dict[str, Any]):
+    def __init__(self, doc: Dict[str, Any], input_warnings: List[str]):
         self._doc = doc
         self.converged: bool = doc["converged"]
         self.message: str = doc["message"]
-        self.warnings: List[str] = doc["input_warnings"]
+        self.warnings: List[str] = input_warnings
         self.params: Dict[str, Dict[str, Any]] = {
             name: {
                 "value": doc[name]["value"],
@@ -48,9 +48,11 @@ class WaltonResult:
         return copy.deepcopy(self._doc)
 
     def collisions(self):
-        """Per collision: line, id, e, beta, psi, v_n_m_s, v_s_m_s, impulse_ratio, class,
-        residual (a DataFrame when pandas is installed, else a list of dicts)."""
-        return frame(self._doc["collisions"])
+        """Per collision: line, collision (id), e, beta, psi, v_n_m_s, v_s_m_s, impulse_ratio,
+        class, residual (a DataFrame when pandas is installed, else a list of dicts)."""
+        rows = self._doc["collisions"]
+        keys = list(rows[0]) if rows else []
+        return frame({k: [r[k] for r in rows] for k in keys})
 
     def table(self):
         """One row per parameter: value, stderr, ci95_low, ci95_high."""
@@ -87,8 +89,9 @@ class WaltonResult:
         )
         d = self._doc
         return (
-            f"<p>Walton fit of {html.escape(str(d['path']))}: {d['n']} collisions "
-            f"({d['n_sliding']} sliding, {d['n_rolling']} rolling, {d['n_head_on']} head-on); "
+            f"<p>Walton fit of {html.escape(str(d['data']['path']))}: {d['n']} collisions "
+            f"({d['classes']['sliding']} sliding, {d['classes']['rolling']} rolling, "
+            f"{d['classes']['head_on']} head-on); "
             f"{html.escape(self.message)}</p><table><tr><th>parameter</th><th>value</th>"
             f"<th>stderr</th><th>95% interval (bootstrap)</th></tr>{rows}</table>"
         )
@@ -143,8 +146,7 @@ def walton_fit(
         bootstrap=bootstrap,
         seed=seed,
     )
-    doc["input_warnings"] = source.relocate_lines(doc["input_warnings"])
-    return WaltonResult(doc)
+    return WaltonResult(json.loads(doc["json"]), source.relocate_lines(doc["input_warnings"]))
 
 
 class KinematicsResult:
