@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# CPU time of `fit` on 100 000 rows, per model: the Fig. 7 data repeated (rows that share a pair
+# geometry and a speed, merged exactly by the fit), and the same rows with every speed moved by
+# up to 0.1% (100 000 distinct points: the certified search's cost grows with them). Quoted in
+# the README (fuzzing; known limitations). The distinct-speed powerlaw fit takes about 40 s.
+#
+# Usage: bash scripts/time_big_fit.sh [BINARY]   (default target/release/restitution)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+BIN=${1:-target/release/restitution}
+[ -x "$BIN" ] || cargo build --release --quiet
+dir=$(mktemp -d)
+trap 'rm -rf "$dir"' EXIT
+python3 - "$dir" <<'PY'
+import random, sys
+d = sys.argv[1]
+lines = [l for l in open("data/fig7_nylon.csv") if not l.startswith("#") and l.strip()]
+head, rows = lines[0], lines[1:]
+random.seed(1)
+with open(f"{d}/repeated.csv", "w") as a, open(f"{d}/distinct.csv", "w") as b:
+    a.write(head)
+    b.write(head)
+    for i in range(100_000):
+        r = rows[i % len(rows)]
+        a.write(r)
+        f = r.rstrip("\n").split(",")
+        f[1] = repr(float(f[1]) * (1 + random.uniform(-1e-3, 1e-3)))
+        b.write(",".join(f) + "\n")
+PY
+for data in repeated distinct; do
+    for m in vm pm min product powerlaw; do
+        /usr/bin/time -f "$data $m: %U s user + %S s system" \
+            "$BIN" fit "$dir/$data.csv" --material nylon --model "$m" > /dev/null 2> "$dir/err" || true
+        tail -1 "$dir/err"
+    done
+done
