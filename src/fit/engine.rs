@@ -362,7 +362,7 @@ fn summarise(
         .collect();
     if let Some(m) = merged {
         notes.push(format!(
-            "{} rows share {} distinct (d, d2, v_n) points: fitted as those points with their              weighted mean e (exact: chi2 differs by the constant {})",
+            "{} rows share {} distinct (d, d2, v_n) points: fitted as those points with their weighted mean e (exact: chi2 differs by the constant {})",
             n,
             m.data.len(),
             crate::error::Num(m.chi2_offset)
@@ -491,17 +491,22 @@ pub fn fit_all(data: &FitData, kinds: &[ModelKind], options: &FitOptions) -> Res
         });
     }
     // The models are independent: fit them on separate threads (results do not depend on the
-    // number of threads; each fit is deterministic).
-    let fits = std::thread::scope(|s| {
-        let handles: Vec<_> = kinds
-            .iter()
-            .map(|&k| s.spawn(move || fit(data, k, options)))
-            .collect();
-        handles
-            .into_iter()
-            .map(|h| h.join().expect("a fit thread panicked"))
-            .collect::<Result<Vec<_>>>()
-    })?;
+    // number of threads; each fit is deterministic). One model runs here: a thread would only
+    // add its start-up to the main job's whole-process time.
+    let fits = if let [k] = kinds[..] {
+        vec![fit(data, k, options)?]
+    } else {
+        std::thread::scope(|s| {
+            let handles: Vec<_> = kinds
+                .iter()
+                .map(|&k| s.spawn(move || fit(data, k, options)))
+                .collect();
+            handles
+                .into_iter()
+                .map(|h| h.join().expect("a fit thread panicked"))
+                .collect::<Result<Vec<_>>>()
+        })?
+    };
     let comparison = (fits.len() >= 2).then(|| compare(&fits));
     Ok(FitSet {
         fits,
