@@ -127,16 +127,7 @@ fn kinematics<'py>(
         let place = |t: &restitution::data::tracks::CollisionTrack| {
             format!("{}:{}: collision '{}'", table.path, t.first_line, t.id)
         };
-        let inputs: Vec<CollisionInput> = tracks
-            .iter()
-            .map(|t| CollisionInput {
-                frames: &t.frames,
-                split: t.split,
-                d1_m: t.d1_m,
-                d2_m: t.d2_m,
-                spins_rad_s: t.spins_rad_s,
-            })
-            .collect();
+        let inputs: Vec<CollisionInput> = tracks.iter().map(|t| t.input()).collect();
         let options = BatchOptions {
             material,
             inertia_k,

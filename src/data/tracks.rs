@@ -26,6 +26,19 @@ pub struct CollisionTrack {
     pub spins_rad_s: Option<[f64; 4]>,
 }
 
+impl CollisionTrack {
+    /// This collision as an input of the library's batch measurement.
+    pub fn input(&self) -> crate::kinematics::batch::CollisionInput<'_> {
+        crate::kinematics::batch::CollisionInput {
+            frames: &self.frames,
+            split: self.split,
+            d1_m: self.d1_m,
+            d2_m: self.d2_m,
+            spins_rad_s: self.spins_rad_s,
+        }
+    }
+}
+
 const SPIN_COLUMNS: [&str; 4] = ["w1z_rad_s", "w2z_rad_s", "w1z_post_rad_s", "w2z_post_rad_s"];
 
 /// Reads and validates a tracks file.
