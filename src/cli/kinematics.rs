@@ -19,13 +19,16 @@
 //! schema), all or none, so that the three commands chain.
 
 use super::{CliResult, Format, MaterialArgs};
+use restitution::data::report::kinematics::{
+    COLUMNS, Row, fit_input_csv, kinematics_csv, kinematics_json,
+};
 use restitution::data::tracks::read_tracks;
 use restitution::data::walton::write_collisions;
 use restitution::data::{CsvOut, fmt_num, write_all_atomic};
 use restitution::experiment::Camera;
 use restitution::fit::walton::CollisionRecord;
 use restitution::kinematics::batch::{BatchOptions, CollisionInput, measure_batch};
-use restitution::kinematics::{Eq8Inputs, FitKind, G_STANDARD_M_S2, Measurement};
+use restitution::kinematics::{Eq8Inputs, FitKind, G_STANDARD_M_S2};
 use restitution::models::walton::K_HOMOGENEOUS;
 use std::path::PathBuf;
 
@@ -74,93 +77,6 @@ pub struct Args {
 
 /// Most skipped collisions named one by one.
 const MAX_WARNINGS: usize = 20;
-
-const COLUMNS: [&str; 27] = [
-    "collision",
-    "t_c_s",
-    "time_rule",
-    "n_pre",
-    "n_post",
-    "v1x_m_s",
-    "v1y_m_s",
-    "v2x_m_s",
-    "v2y_m_s",
-    "v1x_post_m_s",
-    "v1y_post_m_s",
-    "v2x_post_m_s",
-    "v2y_post_m_s",
-    "v_err_m_s",
-    "sigma_pos_m",
-    "v_n_m_s",
-    "v_n_err_m_s",
-    "e",
-    "e_err",
-    "e_err_eq8",
-    "eq8_dv_m_s",
-    "beta",
-    "psi",
-    "momentum_dvx_m_s",
-    "momentum_dvy_m_s",
-    "d1_mm",
-    "d2_mm",
-];
-
-struct Row {
-    id: String,
-    d1_mm: f64,
-    d2_mm: f64,
-    m: Measurement,
-}
-
-impl Row {
-    fn cells(&self) -> Vec<String> {
-        let k = &self.m.kinematics;
-        let me = &self.m.measured;
-        let v_err = self
-            .m
-            .v_err_m_s
-            .iter()
-            .map(|v| v.norm_squared())
-            .sum::<f64>()
-            / 8.0;
-        let dv = me.com_velocity_change_m_s.unwrap_or_default();
-        let mut c = vec![
-            self.id.clone(),
-            fmt_num(k.t_c_s),
-            k.time_rule.name().into(),
-            k.n_pre.to_string(),
-            k.n_post.to_string(),
-        ];
-        for v in &k.v_m_s {
-            c.push(fmt_num(v.x));
-            c.push(fmt_num(v.y));
-        }
-        for x in [
-            v_err.sqrt(),
-            self.m.sigma_pos_m,
-            me.v_n_m_s,
-            self.m.v_n_err_m_s,
-            me.e,
-            self.m.e_err,
-            self.m.e_err_eq8,
-            self.m.eq8_dv_m_s,
-        ] {
-            c.push(fmt_num(x));
-        }
-        c.push(me.beta.map(fmt_num).unwrap_or_default());
-        // Head-on (no tangential velocity): psi is infinite, left empty like beta.
-        c.push(if me.psi.is_finite() {
-            fmt_num(me.psi)
-        } else {
-            String::new()
-        });
-        c.push(fmt_num(dv.x));
-        c.push(fmt_num(dv.y));
-        c.push(fmt_num(self.d1_mm));
-        c.push(fmt_num(self.d2_mm));
-        c
-    }
-}
 
 pub fn run(args: Args) -> CliResult {
     let material = args.material.resolve()?;
@@ -308,42 +224,19 @@ pub fn run(args: Args) -> CliResult {
             "free quadratic fits"
         }
     );
-    let table_csv = |comment: Option<&str>| {
-        let mut out = CsvOut::new();
-        if let Some(c) = comment {
-            out.comment(c);
-        }
-        out.record(COLUMNS);
-        for r in &rows {
-            out.record(r.cells());
-        }
-        out.into_string()
-    };
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
-        let mut fit_csv = CsvOut::new();
-        fit_csv.comment(&comment);
-        fit_csv.record(["d_mm", "d2_mm", "v_n_m_s", "e", "e_err"]);
-        for r in &rows {
-            fit_csv.record([
-                fmt_num(r.d1_mm),
-                fmt_num(r.d2_mm),
-                fmt_num(r.m.measured.v_n_m_s),
-                fmt_num(r.m.measured.e),
-                fmt_num(r.m.e_err),
-            ]);
-        }
         let mut walton_csv = CsvOut::new();
         walton_csv.comment(&comment);
         write_all_atomic(&[
             (
                 dir.join("kinematics.csv"),
-                table_csv(Some(&comment)).into_bytes(),
+                kinematics_csv(&rows, Some(&comment)).into_bytes(),
             ),
             (
                 dir.join("fit_input.csv"),
-                fit_csv.into_string().into_bytes(),
+                fit_input_csv(&rows, &comment).into_bytes(),
             ),
             (
                 dir.join("walton_input.csv"),
@@ -353,30 +246,8 @@ pub fn run(args: Args) -> CliResult {
         .map_err(|e| format!("{}: cannot write: {e}", dir.display()))?;
     }
     let text = match args.format {
-        Format::Csv => table_csv(None),
-        Format::Json => {
-            let list: Vec<serde_json::Value> = rows
-                .iter()
-                .map(|r| {
-                    let map: serde_json::Map<String, serde_json::Value> = COLUMNS
-                        .iter()
-                        .zip(r.cells())
-                        .map(|(c, v)| {
-                            let val = match v.parse::<f64>() {
-                                Ok(x) if *c != "collision" && *c != "time_rule" => {
-                                    serde_json::json!(x)
-                                }
-                                _ if v.is_empty() => serde_json::Value::Null,
-                                _ => serde_json::json!(v),
-                            };
-                            (c.to_string(), val)
-                        })
-                        .collect();
-                    serde_json::Value::Object(map)
-                })
-                .collect();
-            serde_json::to_string_pretty(&list).expect("JSON values serialise") + "\n"
-        }
+        Format::Csv => kinematics_csv(&rows, None),
+        Format::Json => kinematics_json(&rows),
         Format::Table => {
             let mut s = format!(
                 "{:>10} {:>7} {:>9} {:>8} {:>8} {:>8} {:>8} {:>7} {:>7} {:>5}/{:<5} time\n",

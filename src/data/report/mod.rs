@@ -4,4 +4,5 @@
 pub mod camera_study;
 pub mod fit;
 pub mod fit_text;
+pub mod kinematics;
 pub mod walton;

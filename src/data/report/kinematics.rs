@@ -1,0 +1,147 @@
+//! The documents of `restitution kinematics`: `kinematics.csv` (one row per measured collision),
+//! its JSON form, and `fit_input.csv` (the `restitution fit` schema), built by the library.
+
+use crate::data::{CsvOut, fmt_num};
+use crate::kinematics::Measurement;
+
+/// The columns of `kinematics.csv` (and the keys of each JSON record).
+pub const COLUMNS: [&str; 27] = [
+    "collision",
+    "t_c_s",
+    "time_rule",
+    "n_pre",
+    "n_post",
+    "v1x_m_s",
+    "v1y_m_s",
+    "v2x_m_s",
+    "v2y_m_s",
+    "v1x_post_m_s",
+    "v1y_post_m_s",
+    "v2x_post_m_s",
+    "v2y_post_m_s",
+    "v_err_m_s",
+    "sigma_pos_m",
+    "v_n_m_s",
+    "v_n_err_m_s",
+    "e",
+    "e_err",
+    "e_err_eq8",
+    "eq8_dv_m_s",
+    "beta",
+    "psi",
+    "momentum_dvx_m_s",
+    "momentum_dvy_m_s",
+    "d1_mm",
+    "d2_mm",
+];
+
+pub struct Row {
+    pub id: String,
+    pub d1_mm: f64,
+    pub d2_mm: f64,
+    pub m: Measurement,
+}
+
+impl Row {
+    pub fn cells(&self) -> Vec<String> {
+        let k = &self.m.kinematics;
+        let me = &self.m.measured;
+        let v_err = self
+            .m
+            .v_err_m_s
+            .iter()
+            .map(|v| v.norm_squared())
+            .sum::<f64>()
+            / 8.0;
+        let dv = me.com_velocity_change_m_s.unwrap_or_default();
+        let mut c = vec![
+            self.id.clone(),
+            fmt_num(k.t_c_s),
+            k.time_rule.name().into(),
+            k.n_pre.to_string(),
+            k.n_post.to_string(),
+        ];
+        for v in &k.v_m_s {
+            c.push(fmt_num(v.x));
+            c.push(fmt_num(v.y));
+        }
+        for x in [
+            v_err.sqrt(),
+            self.m.sigma_pos_m,
+            me.v_n_m_s,
+            self.m.v_n_err_m_s,
+            me.e,
+            self.m.e_err,
+            self.m.e_err_eq8,
+            self.m.eq8_dv_m_s,
+        ] {
+            c.push(fmt_num(x));
+        }
+        c.push(me.beta.map(fmt_num).unwrap_or_default());
+        // Head-on (no tangential velocity): psi is infinite, left empty like beta.
+        c.push(if me.psi.is_finite() {
+            fmt_num(me.psi)
+        } else {
+            String::new()
+        });
+        c.push(fmt_num(dv.x));
+        c.push(fmt_num(dv.y));
+        c.push(fmt_num(self.d1_mm));
+        c.push(fmt_num(self.d2_mm));
+        c
+    }
+}
+
+/// `kinematics.csv`: a `# comment` line when given, the header, a row per collision.
+pub fn kinematics_csv(rows: &[Row], comment: Option<&str>) -> String {
+    let mut out = CsvOut::new();
+    if let Some(c) = comment {
+        out.comment(c);
+    }
+    out.record(COLUMNS);
+    for r in rows {
+        out.record(r.cells());
+    }
+    out.into_string()
+}
+
+/// `fit_input.csv`: d_mm, d2_mm, v_n_m_s, e, e_err of each collision, after a `# comment`.
+pub fn fit_input_csv(rows: &[Row], comment: &str) -> String {
+    let mut out = CsvOut::new();
+    out.comment(comment);
+    out.record(["d_mm", "d2_mm", "v_n_m_s", "e", "e_err"]);
+    for r in rows {
+        out.record([
+            fmt_num(r.d1_mm),
+            fmt_num(r.d2_mm),
+            fmt_num(r.m.measured.v_n_m_s),
+            fmt_num(r.m.measured.e),
+            fmt_num(r.m.e_err),
+        ]);
+    }
+    out.into_string()
+}
+
+/// The JSON document: one record per collision with the CSV's columns as keys (numbers as
+/// numbers, empty cells as null, the id and the time rule as strings).
+pub fn kinematics_json(rows: &[Row]) -> String {
+    let list: Vec<serde_json::Value> = rows
+        .iter()
+        .map(|r| {
+            let map: serde_json::Map<String, serde_json::Value> = COLUMNS
+                .iter()
+                .zip(r.cells())
+                .map(|(c, v)| {
+                    let val = match v.parse::<f64>() {
+                        Ok(x) if *c != "collision" && *c != "time_rule" => serde_json::json!(x),
+                        _ if v.is_empty() => serde_json::Value::Null,
+                        _ => serde_json::json!(v),
+                    };
+                    (c.to_string(), val)
+                })
+                .collect();
+            serde_json::Value::Object(map)
+        })
+        .collect();
+    serde_json::to_string_pretty(&list).expect("JSON values serialise") + "\n"
+}
