@@ -50,6 +50,22 @@ fn read(dir: &Path, name: &str) -> String {
     std::fs::read_to_string(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
 }
 
+/// The shipped fit, reports/fit/params.json, as JSON.
+fn shipped_fit() -> serde_json::Value {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/fit/params.json");
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+/// The fit of `model` in a params.json document.
+fn fit_of<'a>(doc: &'a mut serde_json::Value, model: &str) -> &'a mut serde_json::Value {
+    doc["fits"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .find(|f| f["model"] == model)
+        .unwrap()
+}
+
 #[test]
 fn lammps_export_of_the_shipped_vm_fit() {
     let out = scratch("vm");
@@ -77,19 +93,8 @@ fn lammps_export_of_the_shipped_vm_fit() {
     let json: serde_json::Value = serde_json::from_str(&read(&out, "export.json")).unwrap();
     let eta = json["viscoelastic"]["eta_mean"].as_f64().unwrap();
     // The fitted eta of reports/fit/params.json (vm), carried over exactly.
-    let params: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/fit/params.json"),
-        )
-        .unwrap(),
-    )
-    .unwrap();
-    let vm = params["fits"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|f| f["model"] == "vm")
-        .unwrap();
+    let mut params = shipped_fit();
+    let vm = fit_of(&mut params, "vm");
     assert_eq!(eta, vm["params"]["eta"]["value"].as_f64().unwrap());
     // Every pair of the three sizes, written out (no mixing), and one wall fix per size.
     let lines: Vec<&str> = f.lines().filter(|l| l.starts_with("pair_coeff")).collect();
@@ -276,19 +281,8 @@ fn bad_input_gives_one_clear_line_and_no_files() {
     );
     let params = "reports/fit/params.json";
     // The shipped fit with min's sigma_y turned into a bound (no value): not exportable.
-    let mut doc: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/fit/params.json"),
-        )
-        .unwrap(),
-    )
-    .unwrap();
-    let min = doc["fits"]
-        .as_array_mut()
-        .unwrap()
-        .iter_mut()
-        .find(|f| f["model"] == "min")
-        .unwrap();
+    let mut doc = shipped_fit();
+    let min = fit_of(&mut doc, "min");
     min["params"]["sigma_y"]["value"] = serde_json::Value::Null;
     min["params"]["sigma_y"]["status"] = "lower_bound".into();
     let bound_json = serde_json::to_string_pretty(&doc).unwrap();
