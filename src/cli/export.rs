@@ -26,19 +26,12 @@
 //! and 16000 steps per contact and compares the extrapolated e with the toolkit's (fails above
 //! 1e-6).
 
-use super::{CliResult, MaterialArgs};
-use restitution::contact::Material;
-use restitution::data::export::lammps::Friction;
-use restitution::data::export::plan::{self, EngineKind, LawChoice};
-use restitution::data::export::{files, read_params_json, read_walton_json, report, run};
-use restitution::data::{fmt_num, write_all_atomic};
-use restitution::dem::law::FittedCurve;
+use super::{CliResult, MaterialArgs, emit, warn};
+use restitution::data::export::job::{self, ArgStyle, ExportError, ExportOptions, FittedLaw};
+use restitution::data::export::plan::{EngineKind, LawChoice};
+use restitution::data::write_all_atomic;
 use restitution::dem::range::{SpeedRange, Weight};
-use restitution::dem::scene::Scene;
-use restitution::dem::translate::{Request, Translation};
-use restitution::fit::models::ModelKind;
 use restitution::models::viscoelastic::ContactEnd;
-use restitution::plot::export::laws_svg;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
@@ -147,24 +140,8 @@ fn parse_range(s: &str) -> Result<SpeedRange, String> {
     SpeedRange::new(num(parts[0])?, num(parts[1])?).map_err(|e| e.to_string())
 }
 
-/// Largest |LAMMPS e - toolkit e| that --verify accepts (see tests/lammps.rs for why).
-const VERIFY_TOLERANCE: f64 = 1e-6;
-/// Steps per shortest contact of the --verify ladder.
-const LADDER: [u32; 3] = [4000, 8000, 16000];
-
-fn check_positive(flag: &str, x: f64) -> Result<f64, String> {
-    if x.is_finite() && x > 0.0 {
-        Ok(x)
-    } else {
-        Err(format!(
-            "{flag} {}: expected a finite number > 0",
-            fmt_num(x)
-        ))
-    }
-}
-
-/// The fitted curve, material and default sizes from the file or the flags.
-fn curve_and_material(a: &Args) -> Result<(FittedCurve, Material, Vec<f64>, String), String> {
+/// The law from PARAMS.json or from the flags (a flag that the file also gives is an error).
+fn fitted_law(a: &Args) -> Result<FittedLaw, String> {
     if let Some(path) = &a.params {
         for (given, flag) in [
             (a.eta.is_some(), "--eta"),
@@ -182,227 +159,75 @@ fn curve_and_material(a: &Args) -> Result<(FittedCurve, Material, Vec<f64>, Stri
                 ));
             }
         }
-        let file = read_params_json(path).map_err(|e| e.to_string())?;
-        let (curve, entry) = file.curve(a.model.as_deref()).map_err(|e| e.to_string())?;
-        if entry.converged == Some(false) {
-            eprintln!(
-                "restitution: warning: {}: the fit of model {} did not converge",
-                file.path, entry.model
-            );
-        }
-        return Ok((
-            curve,
-            file.material,
-            file.diameters_mm.clone(),
-            format!("{} (model {})", file.path, entry.model),
-        ));
+        return FittedLaw::from_params(path, a.model.as_deref()).map_err(|e| e.to_string());
     }
-    let material = a.material.resolve()?;
-    let kind = match (&a.model, a.eta, a.sigma_y_pa) {
-        (Some(m), _, _) => m.parse::<ModelKind>()?,
-        (None, Some(_), None) => ModelKind::Vm,
-        (None, None, Some(_)) => ModelKind::Pm,
-        (None, Some(_), Some(_)) => {
-            return Err("both --eta and --sigma-y-pa: choose --model min or product".into());
-        }
-        (None, None, None) => {
-            return Err("give PARAMS.json, or the law as flags (--eta and/or --sigma-y-pa)".into());
-        }
-    };
-    let mut params = Vec::new();
-    for spec in kind.params() {
-        let x = match spec.key {
-            "eta" => a.eta.ok_or("--eta is needed for this model")?,
-            "sigma_y" => a
-                .sigma_y_pa
-                .ok_or("--sigma-y-pa is needed for this model")?,
-            _ => {
-                return Err(format!(
-                    "model {kind} can only be exported from PARAMS.json"
-                ));
-            }
-        };
-        params.push(check_positive(
-            &format!("--{}", spec.key.replace('_', "-")),
-            x,
-        )?);
-    }
-    let curve = FittedCurve::new(kind, params, a.contact_end.unwrap_or(ContactEnd::Overlap))
-        .map_err(|e| e.to_string())?;
-    Ok((curve, material, Vec::new(), "command-line flags".into()))
+    FittedLaw::given(
+        ArgStyle::Flags,
+        a.material.resolve()?,
+        a.model.as_deref(),
+        a.eta,
+        a.sigma_y_pa,
+        a.contact_end,
+    )
+    .map_err(|e| e.to_string())
 }
 
 pub fn run(a: Args) -> CliResult {
-    let (curve, material, file_sizes_mm, source) = curve_and_material(&a)?;
-    let sizes_mm = if a.d_mm.is_empty() {
-        file_sizes_mm
-    } else {
-        a.d_mm.clone()
-    };
-    if sizes_mm.is_empty() {
-        return Err("give the scene's sphere sizes with --d-mm".into());
+    let law = fitted_law(&a)?;
+    let (friction, friction_warnings) =
+        job::friction(ArgStyle::Flags, a.walton.as_deref(), a.mu0, a.beta0)
+            .map_err(|e| e.to_string())?;
+    for w in law.warnings.iter().chain(&friction_warnings) {
+        warn(w);
     }
-    for &d in &sizes_mm {
-        check_positive("--d-mm", d)?;
-        if !(1e-3..=1e4).contains(&d) {
-            return Err(format!(
-                "--d-mm {}: expected a diameter from 0.001 to 10000 mm",
-                fmt_num(d)
-            ));
-        }
-    }
-    if let Some(t) = a.tolerance {
-        check_positive("--tolerance", t)?;
-        if a.v_range.is_none() {
-            return Err("--tolerance needs --v-range LO,HI".into());
-        }
-    }
-    if !(2..=100_000).contains(&a.table_points) {
-        return Err(format!(
-            "--table-points {}: expected 2 to 100000",
-            a.table_points
-        ));
-    }
-    if a.v_range.is_none() && curve.kind != ModelKind::Vm {
-        return Err(format!(
-            "model {} has no exact engine form: give the scene's speeds with --v-range LO,HI",
-            curve.kind
-        ));
-    }
-    if a.engine != Engine::Lammps && a.v_range.is_none() {
-        return Err("this engine needs the scene's speeds: --v-range LO,HI".into());
-    }
-    if a.verify && a.engine == Engine::Table {
-        return Err("--verify checks LAMMPS files: use --engine lammps or constant-e".into());
-    }
-    let friction = match (&a.walton, a.mu0) {
-        (Some(w), _) => {
-            let wp = read_walton_json(w).map_err(|e| e.to_string())?;
-            if !wp.converged {
-                eprintln!(
-                    "restitution: warning: {}: the Walton fit did not converge",
-                    w.display()
-                );
-            }
-            Some(Friction {
-                mu0: wp.mu0,
-                beta0: Some(wp.beta0),
-                source: format!("from {}", w.display()),
-            })
-        }
-        (None, Some(mu)) => {
-            if !(mu.is_finite() && mu >= 0.0) {
-                return Err(format!(
-                    "--mu0 {}: expected a finite number >= 0",
-                    fmt_num(mu)
-                ));
-            }
-            if let Some(b) = a.beta0
-                && !(-1.0..=1.0).contains(&b)
-            {
-                return Err(format!(
-                    "--beta0 {}: expected a number in [-1, 1]",
-                    fmt_num(b)
-                ));
-            }
-            Some(Friction {
-                mu0: mu,
-                beta0: a.beta0,
-                source: "from --mu0".into(),
-            })
-        }
-        (None, None) => None,
-    };
-    let scene = Scene::new(
-        material,
-        sizes_mm.iter().map(|d| d * 1e-3).collect(),
-        a.wall,
-    )
-    .map_err(|e| format!("--d-mm: {e}"))?;
-    let tr = Translation::new(Request {
-        curve,
-        scene,
-        range: a.v_range,
+    let options = ExportOptions {
+        style: ArgStyle::Flags,
+        engine: match a.engine {
+            Engine::Lammps => EngineKind::Lammps,
+            Engine::ConstantE => EngineKind::ConstantE,
+            Engine::Table => EngineKind::Table,
+        },
+        law: match a.law {
+            LawArg::Auto => LawChoice::Auto,
+            LawArg::Viscoelastic => LawChoice::Viscoelastic,
+            LawArg::ConstantE => LawChoice::ConstantE,
+        },
+        d_mm: a.d_mm,
+        wall: a.wall,
+        v_range: a.v_range,
         weight: match a.weight {
             WeightArg::Log => Weight::LogUniform,
             WeightArg::Uniform => Weight::Uniform,
         },
-        table_points: a.table_points,
         tolerance: a.tolerance,
-    })
-    .map_err(|e| format!("{source}: {e}"))?;
-
-    let speeds: Vec<f64> = if a.speeds.is_empty() {
-        plan::default_speeds(a.v_range)
-    } else {
-        for &v in &a.speeds {
-            check_positive("--speeds", v)?;
+        table_points: a.table_points,
+        speeds_m_s: a.speeds,
+        friction,
+        verify: a.verify,
+        files: a.out.is_some(),
+    };
+    let done = match job::export(&law, &options) {
+        Ok(done) => done,
+        Err(ExportError::Verify { message, table }) => {
+            eprint!("{table}");
+            return Err(message);
         }
-        a.speeds.clone()
+        Err(e) => return Err(e.to_string()),
     };
-    let engine = match a.engine {
-        Engine::Lammps => EngineKind::Lammps,
-        Engine::ConstantE => EngineKind::ConstantE,
-        Engine::Table => EngineKind::Table,
-    };
-    let law = match a.law {
-        LawArg::Auto => LawChoice::Auto,
-        LawArg::Viscoelastic => LawChoice::Viscoelastic,
-        LawArg::ConstantE => LawChoice::ConstantE,
-    };
-    let plan = plan::plan(&tr, engine, law, friction.as_ref(), &speeds, &source)?;
-    let mut outputs = plan.outputs.clone();
-    if tr.request.range.is_some() {
-        let title = format!("Exported laws for {source}");
-        outputs.push(("laws.svg".into(), laws_svg(&tr, &title)?.into_bytes()));
-    }
-    // A failed verification writes nothing (it runs in a private temporary directory).
-    let verify_rows = match (&plan.lammps_files, a.verify) {
-        (Some(lf), true) => {
-            let rows = run::verify_files(&tr, lf, &LADDER)?;
-            let worst = rows
-                .iter()
-                .map(|r| r.difference().abs())
-                .fold(0.0, f64::max);
-            if worst.is_nan() || worst > VERIFY_TOLERANCE {
-                eprint!("{}", files::verify_table(&rows, VERIFY_TOLERANCE));
-                return Err(format!(
-                    "LAMMPS's e differs from the toolkit's by {worst:.3e} > {VERIFY_TOLERANCE:e}; nothing written"
-                ));
-            }
-            Some(rows)
-        }
-        _ => None,
-    };
-    let mut names: Vec<String> = outputs.iter().map(|(n, _)| n.clone()).collect();
-    if a.out.is_some() {
-        names.push("export.json".into());
-    }
-    let summary = plan.summary(
-        &tr,
-        &source,
-        friction.as_ref(),
-        names,
-        verify_rows.as_deref(),
-    );
     if let Some(dir) = &a.out {
-        outputs.push((
-            "export.json".into(),
-            files::export_json(&summary).into_bytes(),
-        ));
-        write_outputs(dir, &outputs)?;
+        write_outputs(dir, &done.outputs)?;
     }
-    print!("{}", report::report(&summary));
+    let mut text = done.report.clone();
     if a.out.is_none()
-        && let Some(lf) = &plan.lammps_files
+        && let Some(lf) = &done.in_restitution
     {
-        print!("\n--- in.restitution ---\n{}", lf.in_restitution);
+        text += &format!("\n--- in.restitution ---\n{lf}");
     }
-    if let Some(rows) = &verify_rows {
-        println!("\nLAMMPS round trip (lmp on collide.in, N steps per shortest contact):");
-        print!("{}", files::verify_table(rows, VERIFY_TOLERANCE));
+    if let Some(table) = &done.verify_table {
+        text += "\nLAMMPS round trip (lmp on collide.in, N steps per shortest contact):\n";
+        text += table;
     }
-    Ok(())
+    emit(&text)
 }
 
 fn write_outputs(dir: &Path, outputs: &[(String, Vec<u8>)]) -> Result<(), String> {

@@ -3,10 +3,12 @@
 //! come from [`crate::dem`]; this module only formats and parses.
 //!
 //! Submodules: [`plan`] (which law and files an export gives), [`lammps`] (in.restitution,
-//! collide.in), [`run`] (running `lmp` on them and comparing e), [`files`] (constant_e.csv,
+//! collide.in), [`job`] (one export from request to files, for the command line and Python),
+//! [`run`] (running `lmp` on them and comparing e), [`files`] (constant_e.csv,
 //! table.csv, liggghts.in, export.json), [`report`] (the printed summary).
 
 pub mod files;
+pub mod job;
 pub mod lammps;
 pub mod plan;
 pub mod report;

@@ -1,0 +1,424 @@
+//! One export from request to files: the fitted law (from a params.json or given), the friction,
+//! the checks of the request, the scene, the translation, the plan, the optional LAMMPS round
+//! trip and the summary. The command line (`restitution export`) and the Python package
+//! (`restitution.export`) both call [`export`], so they give the same files and numbers; they
+//! differ only in how an argument is named in a message ([`ArgStyle`]).
+
+use super::files::{self, verify_table};
+use super::lammps::Friction;
+use super::plan::{self, EngineKind, LawChoice};
+use super::run::{self, VerifyRow};
+use super::{read_params_json, read_walton_json, report};
+use crate::contact::Material;
+use crate::data::fmt_num;
+use crate::dem::law::FittedCurve;
+use crate::dem::range::{SpeedRange, Weight};
+use crate::dem::scene::Scene;
+use crate::dem::translate::{Request, Translation};
+use crate::fit::models::ModelKind;
+use crate::models::viscoelastic::ContactEnd;
+use std::path::Path;
+
+/// Largest |LAMMPS e - toolkit e| that the round trip accepts: the extrapolated engine e agrees
+/// with the toolkit's to ~1e-9 (tests/lammps.rs), so 1e-6 leaves room for the ladder's residual
+/// without letting a wrong law through (a wrong damping moves e by > 1e-3).
+pub const VERIFY_TOLERANCE: f64 = 1e-6;
+/// Steps per shortest contact of the round trip's ladder (first-order error in e: Richardson).
+pub const LADDER: [u32; 3] = [4000, 8000, 16000];
+
+/// How a message names an argument: `--v-range` on the command line, `v_range` in Python.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ArgStyle {
+    Flags,
+    Keywords,
+}
+
+impl ArgStyle {
+    /// The argument `key` (snake_case) as the user typed it.
+    pub fn name(self, key: &str) -> String {
+        match self {
+            ArgStyle::Flags => format!("--{}", key.replace('_', "-")),
+            ArgStyle::Keywords => key.to_string(),
+        }
+    }
+}
+
+/// Why an export did not happen. Nothing is written in either case.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ExportError {
+    /// A bad argument, file or combination: one line.
+    #[error("{0}")]
+    Input(String),
+    /// LAMMPS ran but its e differs from the toolkit's; `table` shows every collision.
+    #[error("{message}")]
+    Verify { message: String, table: String },
+}
+
+impl From<String> for ExportError {
+    fn from(s: String) -> Self {
+        ExportError::Input(s)
+    }
+}
+
+impl From<super::super::DataError> for ExportError {
+    fn from(e: super::super::DataError) -> Self {
+        ExportError::Input(e.to_string())
+    }
+}
+
+/// The fitted law to export, with the material and sphere sizes it was fitted for.
+#[derive(Debug, Clone)]
+pub struct FittedLaw {
+    pub curve: FittedCurve,
+    pub material: Material,
+    /// The fit data's diameters, mm (empty when the law was given as numbers).
+    pub diameters_mm: Vec<f64>,
+    /// Where the law came from, for the report and the files' comments.
+    pub source: String,
+    /// What the user should know about it (a fit that did not converge).
+    pub warnings: Vec<String>,
+}
+
+impl FittedLaw {
+    /// The law of a params.json written by `restitution fit --out`: the preferred model, or
+    /// `model`.
+    pub fn from_params(path: &Path, model: Option<&str>) -> Result<FittedLaw, ExportError> {
+        let file = read_params_json(path)?;
+        let (curve, entry) = file.curve(model)?;
+        let mut warnings = Vec::new();
+        if entry.converged == Some(false) {
+            warnings.push(format!(
+                "{}: the fit of model {} did not converge",
+                file.path, entry.model
+            ));
+        }
+        Ok(FittedLaw {
+            curve,
+            material: file.material,
+            diameters_mm: file.diameters_mm.clone(),
+            source: format!("{} (model {})", file.path, entry.model),
+            warnings,
+        })
+    }
+
+    /// A law given as numbers: `model` (default: vm with eta alone, pm with sigma_y alone) with
+    /// its parameters.
+    pub fn given(
+        style: ArgStyle,
+        material: Material,
+        model: Option<&str>,
+        eta: Option<f64>,
+        sigma_y_pa: Option<f64>,
+        contact_end: Option<ContactEnd>,
+    ) -> Result<FittedLaw, ExportError> {
+        let (n_eta, n_sigma) = (style.name("eta"), style.name("sigma_y_pa"));
+        let kind = match (model, eta, sigma_y_pa) {
+            (Some(m), _, _) => m.parse::<ModelKind>()?,
+            (None, Some(_), None) => ModelKind::Vm,
+            (None, None, Some(_)) => ModelKind::Pm,
+            (None, Some(_), Some(_)) => {
+                return Err(format!(
+                    "both {n_eta} and {n_sigma}: choose {} min or product",
+                    style.name("model")
+                )
+                .into());
+            }
+            (None, None, None) => {
+                return Err(format!(
+                    "give PARAMS.json, or the law as numbers ({n_eta} and/or {n_sigma})"
+                )
+                .into());
+            }
+        };
+        let mut params = Vec::new();
+        for spec in kind.params() {
+            let (x, name) = match spec.key {
+                "eta" => (eta, &n_eta),
+                "sigma_y" => (sigma_y_pa, &n_sigma),
+                _ => {
+                    return Err(
+                        format!("model {kind} can only be exported from PARAMS.json").into(),
+                    );
+                }
+            };
+            let x = x.ok_or_else(|| format!("{name} is needed for this model"))?;
+            params.push(positive(name, x)?);
+        }
+        let curve = FittedCurve::new(kind, params, contact_end.unwrap_or(ContactEnd::Overlap))
+            .map_err(|e| e.to_string())?;
+        Ok(FittedLaw {
+            curve,
+            material,
+            diameters_mm: Vec::new(),
+            source: match style {
+                ArgStyle::Flags => "command-line flags",
+                ArgStyle::Keywords => "keyword arguments",
+            }
+            .into(),
+            warnings: Vec::new(),
+        })
+    }
+}
+
+/// The friction of the exported scene, from a walton.json or given, and its warnings.
+pub fn friction(
+    style: ArgStyle,
+    walton: Option<&Path>,
+    mu0: Option<f64>,
+    beta0: Option<f64>,
+) -> Result<(Option<Friction>, Vec<String>), ExportError> {
+    match (walton, mu0) {
+        (Some(_), Some(_)) => Err(format!(
+            "{} and {}: give one",
+            style.name("walton"),
+            style.name("mu0")
+        )
+        .into()),
+        (Some(w), None) => {
+            let wp = read_walton_json(w)?;
+            let mut warnings = Vec::new();
+            if !wp.converged {
+                warnings.push(format!("{}: the Walton fit did not converge", w.display()));
+            }
+            Ok((
+                Some(Friction {
+                    mu0: wp.mu0,
+                    beta0: Some(wp.beta0),
+                    source: format!("from {}", w.display()),
+                }),
+                warnings,
+            ))
+        }
+        (None, Some(mu)) => {
+            if !(mu.is_finite() && mu >= 0.0) {
+                return Err(format!(
+                    "{} {}: expected a finite number >= 0",
+                    style.name("mu0"),
+                    fmt_num(mu)
+                )
+                .into());
+            }
+            if let Some(b) = beta0
+                && !(-1.0..=1.0).contains(&b)
+            {
+                return Err(format!(
+                    "{} {}: expected a number in [-1, 1]",
+                    style.name("beta0"),
+                    fmt_num(b)
+                )
+                .into());
+            }
+            Ok((
+                Some(Friction {
+                    mu0: mu,
+                    beta0,
+                    source: format!("from {}", style.name("mu0")),
+                }),
+                Vec::new(),
+            ))
+        }
+        (None, None) => match beta0 {
+            Some(_) => Err(format!("{} needs {}", style.name("beta0"), style.name("mu0")).into()),
+            None => Ok((None, Vec::new())),
+        },
+    }
+}
+
+/// What the export is for, besides the law.
+#[derive(Debug, Clone)]
+pub struct ExportOptions {
+    pub style: ArgStyle,
+    pub engine: EngineKind,
+    pub law: LawChoice,
+    /// The scene's sphere sizes, mm (one engine type each); empty: the law's.
+    pub d_mm: Vec<f64>,
+    pub wall: bool,
+    pub v_range: Option<SpeedRange>,
+    pub weight: Weight,
+    pub tolerance: Option<f64>,
+    pub table_points: usize,
+    /// Speeds of collide.in, m/s; empty: [`plan::default_speeds`].
+    pub speeds_m_s: Vec<f64>,
+    pub friction: Option<Friction>,
+    /// Run `lmp` on collide.in ([`LADDER`]) and fail above [`VERIFY_TOLERANCE`].
+    pub verify: bool,
+    /// The files will be written, so export.json is one of them (and lists itself).
+    pub files: bool,
+}
+
+/// A finished export: every file (name, bytes), the summary document (export.json's text), the
+/// printed report and the round trip's table.
+#[derive(Debug, Clone)]
+pub struct Exported {
+    pub outputs: Vec<(String, Vec<u8>)>,
+    pub json: String,
+    pub report: String,
+    /// in.restitution's text, when the engine is LAMMPS (the command line prints it without
+    /// --out).
+    pub in_restitution: Option<String>,
+    pub verify: Option<Vec<VerifyRow>>,
+    /// The round trip's table, as printed.
+    pub verify_table: Option<String>,
+}
+
+fn positive(name: &str, x: f64) -> Result<f64, String> {
+    if x.is_finite() && x > 0.0 {
+        Ok(x)
+    } else {
+        Err(format!(
+            "{name} {}: expected a finite number > 0",
+            fmt_num(x)
+        ))
+    }
+}
+
+/// Checks the request, translates the law for the scene and builds every file. With
+/// `verify`, LAMMPS (`lmp`) runs in a private temporary directory.
+pub fn export(law: &FittedLaw, o: &ExportOptions) -> Result<Exported, ExportError> {
+    let name = |k: &str| o.style.name(k);
+    let sizes_mm = if o.d_mm.is_empty() {
+        law.diameters_mm.clone()
+    } else {
+        o.d_mm.clone()
+    };
+    if sizes_mm.is_empty() {
+        return Err(format!("give the scene's sphere sizes with {}", name("d_mm")).into());
+    }
+    for &d in &sizes_mm {
+        positive(&name("d_mm"), d)?;
+        if !(1e-3..=1e4).contains(&d) {
+            return Err(format!(
+                "{} {}: expected a diameter from 0.001 to 10000 mm",
+                name("d_mm"),
+                fmt_num(d)
+            )
+            .into());
+        }
+    }
+    if let Some(t) = o.tolerance {
+        positive(&name("tolerance"), t)?;
+        if o.v_range.is_none() {
+            return Err(format!("{} needs {} LO,HI", name("tolerance"), name("v_range")).into());
+        }
+    }
+    if !(2..=100_000).contains(&o.table_points) {
+        return Err(format!(
+            "{} {}: expected 2 to 100000",
+            name("table_points"),
+            o.table_points
+        )
+        .into());
+    }
+    if o.v_range.is_none() && law.curve.kind != ModelKind::Vm {
+        return Err(format!(
+            "model {} has no exact engine form: give the scene's speeds with {} LO,HI",
+            law.curve.kind,
+            name("v_range")
+        )
+        .into());
+    }
+    if o.engine != EngineKind::Lammps && o.v_range.is_none() {
+        return Err(format!(
+            "this engine needs the scene's speeds: {} LO,HI",
+            name("v_range")
+        )
+        .into());
+    }
+    if o.verify && o.engine == EngineKind::Table {
+        return Err(format!(
+            "{} checks LAMMPS files: use {} lammps or constant-e",
+            name("verify"),
+            name("engine")
+        )
+        .into());
+    }
+    let scene = Scene::new(
+        law.material,
+        sizes_mm.iter().map(|d| d * 1e-3).collect(),
+        o.wall,
+    )
+    .map_err(|e| format!("{}: {e}", name("d_mm")))?;
+    let tr = Translation::new(Request {
+        curve: law.curve.clone(),
+        scene,
+        range: o.v_range,
+        weight: o.weight,
+        table_points: o.table_points,
+        tolerance: o.tolerance,
+    })
+    .map_err(|e| format!("{}: {e}", law.source))?;
+    let speeds: Vec<f64> = if o.speeds_m_s.is_empty() {
+        plan::default_speeds(o.v_range)
+    } else {
+        for &v in &o.speeds_m_s {
+            positive(&name("speeds"), v)?;
+        }
+        o.speeds_m_s.clone()
+    };
+    let plan = plan::plan(
+        &tr,
+        o.engine,
+        o.law,
+        o.friction.as_ref(),
+        &speeds,
+        &law.source,
+    )?;
+    let mut outputs = plan.outputs.clone();
+    #[cfg(feature = "plot")]
+    if tr.request.range.is_some() {
+        let title = format!("Exported laws for {}", law.source);
+        outputs.push((
+            "laws.svg".into(),
+            crate::plot::export::laws_svg(&tr, &title)?.into_bytes(),
+        ));
+    }
+    let verify_rows = match (&plan.lammps_files, o.verify) {
+        (Some(lf), true) => {
+            let rows = run::verify_files(&tr, lf, &LADDER)?;
+            let worst = rows
+                .iter()
+                .map(|r| r.difference().abs())
+                .fold(0.0, f64::max);
+            if worst.is_nan() || worst > VERIFY_TOLERANCE {
+                return Err(ExportError::Verify {
+                    message: format!(
+                        "LAMMPS's e differs from the toolkit's by {worst:.3e} > {VERIFY_TOLERANCE:e}; nothing written"
+                    ),
+                    table: verify_table(&rows, VERIFY_TOLERANCE),
+                });
+            }
+            Some(rows)
+        }
+        _ => None,
+    };
+    let mut names: Vec<String> = outputs.iter().map(|(n, _)| n.clone()).collect();
+    if o.files {
+        names.push("export.json".into());
+    }
+    let summary = plan.summary(
+        &tr,
+        &law.source,
+        o.friction.as_ref(),
+        names,
+        verify_rows.as_deref(),
+    );
+    let json = files::export_json(&summary);
+    let report = report::report(&summary);
+    if o.files {
+        outputs.push(("export.json".into(), json.clone().into_bytes()));
+    }
+    let verify_table = verify_rows
+        .as_deref()
+        .map(|rows| verify_table(rows, VERIFY_TOLERANCE));
+    Ok(Exported {
+        outputs,
+        json,
+        report,
+        in_restitution: plan
+            .lammps_files
+            .as_ref()
+            .map(|lf| lf.in_restitution.clone()),
+        verify: verify_rows,
+        verify_table,
+    })
+}
