@@ -10,7 +10,7 @@ behind the ``restitution`` command line directly, so every number is the command
 >>> r.preferred, r.params["min"]["eta"], r.table()
 
 Functions: :func:`predict`, :func:`e_of_kappa`, :func:`e_of_u`, :func:`fit`,
-:func:`walton_fit`, :func:`kinematics`. Units are in argument and column names (``v_m_s``,
+:func:`walton_fit`, :func:`kinematics`, :func:`export`. Units are in argument and column names (``v_m_s``,
 ``d_mm``, ``sigma_y_pa``), SI otherwise. Bad input raises :class:`InputError` (a ValueError)
 with the command line's one-line message; a numerical method that gives up raises
 :class:`NumericalError` (a RuntimeError). Long calls release the GIL.
@@ -20,11 +20,13 @@ from ._restitution import InputError, NumericalError, material_presets
 from ._models import DEFAULT_TOL, e_of_kappa, e_of_u, predict
 from ._fit import FIT_COLUMNS, DataWarning, FitResult, fit
 from ._walton import KinematicsResult, WaltonResult, kinematics, walton_fit
+from ._export import VERIFY_TOLERANCE, ExportResult, export
 
 __all__ = [
     "DEFAULT_TOL",
     "FIT_COLUMNS",
     "DataWarning",
+    "ExportResult",
     "FitResult",
     "InputError",
     "KinematicsResult",
@@ -32,9 +34,11 @@ __all__ = [
     "WaltonResult",
     "e_of_kappa",
     "e_of_u",
+    "export",
     "fit",
     "kinematics",
     "material_presets",
     "predict",
+    "VERIFY_TOLERANCE",
     "walton_fit",
 ]

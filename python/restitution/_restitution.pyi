@@ -102,3 +102,35 @@ def kinematics(
     subpixel_expansion: float = ...,
     strict: bool = ...,
 ) -> Dict[str, Any]: ...
+
+VERIFY_TOLERANCE: float
+
+def export(
+    engine: str,
+    params_path: Optional[Union[str, PathLike[str]]] = ...,
+    params_name: Optional[str] = ...,
+    params_text: Optional[str] = ...,
+    model: Optional[str] = ...,
+    walton_path: Optional[Union[str, PathLike[str]]] = ...,
+    walton_name: Optional[str] = ...,
+    walton_text: Optional[str] = ...,
+    mu0: Optional[float] = ...,
+    beta0: Optional[float] = ...,
+    material: Optional[str] = ...,
+    youngs_pa: Optional[float] = ...,
+    poisson: Optional[float] = ...,
+    density_kg_m3: Optional[float] = ...,
+    d_mm: Optional[List[float]] = ...,
+    wall: bool = ...,
+    eta: Optional[float] = ...,
+    sigma_y_pa: Optional[float] = ...,
+    contact_end: Optional[str] = ...,
+    v_range: Optional[Tuple[float, float]] = ...,
+    weight: str = ...,
+    tolerance: Optional[float] = ...,
+    table_points: int = ...,
+    law: str = ...,
+    speeds_m_s: Optional[List[float]] = ...,
+    out: Optional[Union[str, PathLike[str]]] = ...,
+    verify: bool = ...,
+) -> Dict[str, Any]: ...

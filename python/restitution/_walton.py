@@ -152,10 +152,12 @@ def walton_fit(
 class KinematicsResult:
     """The outcome of :func:`kinematics`: one row per measured collision.
 
-    ``to_dict()["columns"]`` holds the CLI's ``kinematics.csv`` columns with the same names
-    and values, except that the CLI's single ``v_err_m_s`` (the rms of the eight velocity
-    errors) is given here as the eight errors ``v1x_err_m_s`` ... ``v2y_post_err_m_s``, and the
-    momentum check of a collision without one is None rather than 0.
+    ``to_dict()`` is exactly the document of ``restitution kinematics --format json`` (built by
+    the same library function): a list with one record per collision whose keys are the
+    ``kinematics.csv`` columns. ``columns()`` gives the same numbers by column, with the CLI's
+    single ``v_err_m_s`` (the rms of the eight velocity errors) split into the eight errors
+    ``v1x_err_m_s`` ... ``v2y_post_err_m_s``, and None for a momentum check a collision does
+    not have (the CLI's 0).
 
     Attributes
     ----------
@@ -170,26 +172,33 @@ class KinematicsResult:
         is also issued as a ``UserWarning``).
     """
 
-    def __init__(self, doc: Dict[str, Any]):
-        self._doc = doc
-        self.sigma_pos_m: float = doc["sigma_pos_m"]
-        self.skipped: List[str] = doc["skipped"]
-        self.fits_meet: List[str] = doc["fits_meet"]
-        self.unmeasured_spins: List[str] = doc["unmeasured_spins"]
+    def __init__(self, raw: Dict[str, Any]):
+        self._raw = raw
+        self._doc = json.loads(raw["json"])
+        self.sigma_pos_m: float = raw["sigma_pos_m"]
+        self.subpixel_m: float = raw["subpixel_m"]
+        self.skipped: List[str] = raw["skipped"]
+        self.fits_meet: List[str] = raw["fits_meet"]
+        self.unmeasured_spins: List[str] = raw["unmeasured_spins"]
         for line in self.unmeasured_spins:
             warnings.warn(line, UserWarning, stacklevel=3)
 
-    def to_dict(self) -> Dict[str, Any]:
+    def to_dict(self) -> List[Dict[str, Any]]:
+        """The ``restitution kinematics --format json`` document (a list of records)."""
         return copy.deepcopy(self._doc)
+
+    def columns(self) -> Dict[str, List[Any]]:
+        """The per-collision numbers by column, with the eight velocity errors."""
+        return copy.deepcopy(self._raw["columns"])
 
     def table(self):
         """The per-collision columns (a DataFrame when pandas is installed, else row dicts)."""
-        return frame(self._doc["columns"])
+        return frame(self._raw["columns"])
 
     def fit_data(self) -> Dict[str, List[float]]:
         """The columns :func:`fit` takes (``d_mm, d2_mm, v_n_m_s, e, e_err``), so the two
         chain as ``fit(k.fit_data(), "nylon")``."""
-        c = self._doc["columns"]
+        c = self._raw["columns"]
         return {
             "d_mm": list(c["d1_mm"]),
             "d2_mm": list(c["d2_mm"]),
@@ -199,7 +208,7 @@ class KinematicsResult:
         }
 
     def __repr__(self) -> str:
-        n = len(self._doc["columns"]["e"])
+        n = len(self._doc)
         return f"<KinematicsResult: {n} collisions, {len(self.skipped)} skipped>"
 
 

@@ -1,18 +1,17 @@
-//! `kinematics`: the calls of `restitution kinematics` (src/cli/kinematics.rs): read the tracks,
-//! split and fit each collision, pool the position noise over all of them, then measure each.
-//!
-//! The two-pass pooling lives in the CLI's `run` today, not in the library; this follows the same
-//! sequence of library calls (`split_at_contact`, `analyse`, `measure_collision`) so the numbers
-//! agree, until the library exposes the whole pass as one function.
+//! `kinematics`: the call of `restitution kinematics` (src/cli/kinematics.rs): read the tracks
+//! and run the library's whole pass (`data::report::kinematics::measure_tracks`: noise pooled
+//! over every collision, then each measured), and its JSON document, built by the same library
+//! function as the command line's (`kinematics_json`).
 
 use crate::{Failure, Outcome, Source, run_detached};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use restitution::data::fmt_num;
+use restitution::data::report::kinematics::{Measured, Row, kinematics_json, measure_tracks};
 use restitution::data::tracks::parse_tracks;
 use restitution::experiment::Camera;
-use restitution::kinematics::batch::{BatchOptions, CollisionInput, measure_batch};
-use restitution::kinematics::{Eq8Inputs, FitKind, G_STANDARD_M_S2, Measurement, TimeRule};
+use restitution::kinematics::batch::BatchOptions;
+use restitution::kinematics::{Eq8Inputs, FitKind, G_STANDARD_M_S2};
 use restitution::models::walton::K_HOMOGENEOUS;
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -29,20 +28,11 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
-struct Row {
-    id: String,
-    d1_mm: f64,
-    d2_mm: f64,
-    m: Measurement,
-}
-
 struct Done {
-    rows: Vec<Row>,
-    sigma_pos_m: f64,
+    measured: Measured,
     subpixel_m: f64,
-    skipped: Vec<String>,
-    /// Spins not measured, taken as 0 (one line per collision, as the CLI warns).
-    unmeasured: Vec<String>,
+    /// The command line's `--format json` document.
+    json: String,
 }
 
 /// Velocities, e, beta and psi from tracked centres, as `restitution kinematics` computes them.
@@ -124,61 +114,29 @@ fn kinematics<'py>(
         };
         let table = source?.table()?;
         let tracks = parse_tracks(&table)?;
-        let place = |t: &restitution::data::tracks::CollisionTrack| {
-            format!("{}:{}: collision '{}'", table.path, t.first_line, t.id)
-        };
-        let inputs: Vec<CollisionInput> = tracks.iter().map(|t| t.input()).collect();
         let options = BatchOptions {
             material,
             inertia_k,
             kind,
             eq8,
         };
-        // The command line's batch: the noise pooled over every collision.
-        let batch = measure_batch(&inputs, &options);
-        let sigma = batch.sigma_pos_m;
-        let mut skipped: Vec<String> = batch
-            .skipped
-            .iter()
-            .map(|(i, e)| format!("{}: {e}", place(&tracks[*i])))
-            .collect();
-        let unmeasured: Vec<String> = batch
-            .unmeasured_spins
-            .iter()
-            .map(|(i, names)| {
-                format!(
-                    "{}: {} not measured (empty): taken as 0 in beta and psi",
-                    place(&tracks[*i]),
-                    names.join(", ")
-                )
-            })
-            .collect();
-        let rows: Vec<Row> = batch
-            .measured
-            .into_iter()
-            .map(|(i, m)| Row {
-                id: tracks[i].id.clone(),
-                d1_mm: tracks[i].d1_m * 1e3,
-                d2_mm: tracks[i].d2_m * 1e3,
-                m,
-            })
-            .collect();
-        if !skipped.is_empty() && (strict || rows.is_empty()) {
-            return Err(Failure::Input(skipped.swap_remove(0)));
+        let measured = measure_tracks(&table.path, &tracks, &options);
+        if !measured.skipped.is_empty() && (strict || measured.rows.is_empty()) {
+            return Err(Failure::Input(measured.skipped[0].clone()));
         }
+        let json = kinematics_json(&measured.rows);
         Ok(Done {
-            rows,
-            sigma_pos_m: sigma,
+            measured,
             subpixel_m,
-            skipped,
-            unmeasured,
+            json,
         })
     })?;
     to_dict(py, &done)
 }
 
 fn to_dict<'py>(py: Python<'py>, done: &Done) -> PyResult<Bound<'py, PyDict>> {
-    let rows = &done.rows;
+    let m = &done.measured;
+    let rows = &m.rows;
     let col = |f: &dyn Fn(&Row) -> f64| rows.iter().map(f).collect::<Vec<f64>>();
     let c = PyDict::new(py);
     c.set_item(
@@ -239,16 +197,11 @@ fn to_dict<'py>(py: Python<'py>, done: &Done) -> PyResult<Bound<'py, PyDict>> {
     c.set_item("d2_mm", col(&|r| r.d2_mm))?;
     let d = PyDict::new(py);
     d.set_item("columns", c)?;
-    d.set_item("sigma_pos_m", done.sigma_pos_m)?;
+    d.set_item("sigma_pos_m", m.sigma_pos_m)?;
     d.set_item("subpixel_m", done.subpixel_m)?;
-    d.set_item("skipped", done.skipped.clone())?;
-    d.set_item("unmeasured_spins", done.unmeasured.clone())?;
-    d.set_item(
-        "fits_meet",
-        rows.iter()
-            .filter(|r| r.m.kinematics.time_rule != TimeRule::ContactDistance)
-            .map(|r| r.id.clone())
-            .collect::<Vec<_>>(),
-    )?;
+    d.set_item("skipped", m.skipped.clone())?;
+    d.set_item("unmeasured_spins", m.unmeasured_spins.clone())?;
+    d.set_item("fits_meet", m.fits_meet.clone())?;
+    d.set_item("json", done.json.clone())?;
     Ok(d)
 }

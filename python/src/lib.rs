@@ -18,6 +18,7 @@ use restitution::data::DataError;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 mod bench;
+mod export;
 mod fit;
 mod kinematics;
 mod models;
@@ -206,5 +207,6 @@ fn _restitution(m: &Bound<'_, PyModule>) -> PyResult<()> {
     fit::register(m)?;
     walton::register(m)?;
     kinematics::register(m)?;
+    export::register(m)?;
     Ok(())
 }

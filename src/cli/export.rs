@@ -27,7 +27,9 @@
 //! 1e-6).
 
 use super::{CliResult, MaterialArgs, emit, warn};
-use restitution::data::export::job::{self, ArgStyle, ExportError, ExportOptions, FittedLaw};
+use restitution::data::export::job::{
+    self, ArgStyle, ExportError, ExportOptions, FittedLaw, JsonSource,
+};
 use restitution::data::export::plan::{EngineKind, LawChoice};
 use restitution::data::write_all_atomic;
 use restitution::dem::range::{SpeedRange, Weight};
@@ -159,7 +161,8 @@ fn fitted_law(a: &Args) -> Result<FittedLaw, String> {
                 ));
             }
         }
-        return FittedLaw::from_params(path, a.model.as_deref()).map_err(|e| e.to_string());
+        return FittedLaw::from_params(JsonSource::Path(path), a.model.as_deref())
+            .map_err(|e| e.to_string());
     }
     FittedLaw::given(
         ArgStyle::Flags,
@@ -174,9 +177,13 @@ fn fitted_law(a: &Args) -> Result<FittedLaw, String> {
 
 pub fn run(a: Args) -> CliResult {
     let law = fitted_law(&a)?;
-    let (friction, friction_warnings) =
-        job::friction(ArgStyle::Flags, a.walton.as_deref(), a.mu0, a.beta0)
-            .map_err(|e| e.to_string())?;
+    let (friction, friction_warnings) = job::friction(
+        ArgStyle::Flags,
+        a.walton.as_deref().map(JsonSource::Path),
+        a.mu0,
+        a.beta0,
+    )
+    .map_err(|e| e.to_string())?;
     for w in law.warnings.iter().chain(&friction_warnings) {
         warn(w);
     }

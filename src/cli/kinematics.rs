@@ -20,14 +20,13 @@
 
 use super::{CliResult, Format, MaterialArgs};
 use restitution::data::report::kinematics::{
-    COLUMNS, Row, fit_input_csv, kinematics_csv, kinematics_json,
+    Measured, fit_input_csv, kinematics_csv, kinematics_json, measure_tracks,
 };
 use restitution::data::tracks::read_tracks;
 use restitution::data::walton::write_collisions;
 use restitution::data::{CsvOut, fmt_num, write_all_atomic};
 use restitution::experiment::Camera;
-use restitution::fit::walton::CollisionRecord;
-use restitution::kinematics::batch::{BatchOptions, CollisionInput, measure_batch};
+use restitution::kinematics::batch::BatchOptions;
 use restitution::kinematics::{Eq8Inputs, FitKind, G_STANDARD_M_S2};
 use restitution::models::walton::K_HOMOGENEOUS;
 use std::path::PathBuf;
@@ -117,14 +116,6 @@ pub fn run(args: Args) -> CliResult {
     };
     let tracks = read_tracks(&args.path).map_err(|e| e.to_string())?;
     let shown = args.path.display().to_string();
-    let place = |t: &restitution::data::tracks::CollisionTrack| {
-        format!(
-            "{shown}:{}: collision '{}'",
-            t.first_line,
-            restitution::data::shown(&t.id)
-        )
-    };
-    let inputs: Vec<CollisionInput> = tracks.iter().map(|t| t.input()).collect();
     let options = BatchOptions {
         material,
         inertia_k: args.inertia_k,
@@ -134,56 +125,17 @@ pub fn run(args: Args) -> CliResult {
     // The noise pooled over every collision; a collision that cannot be measured (too few
     // frames, receding spheres) is skipped with a warning naming it, so one bad track does not
     // lose a campaign; --strict makes it an error.
-    let batch = measure_batch(&inputs, &options);
-    let sigma = batch.sigma_pos_m;
-    let mut skipped: Vec<(usize, String)> = batch
-        .skipped
-        .iter()
-        .map(|(i, e)| (*i, format!("{}: {e}", place(&tracks[*i]))))
-        .collect();
-    for (i, names) in &batch.unmeasured_spins {
-        super::warn(format_args!(
-            "{}: {} not measured (empty): taken as 0 in beta and psi",
-            place(&tracks[*i]),
-            names.join(", ")
-        ));
+    let Measured {
+        rows,
+        records,
+        skipped,
+        unmeasured_spins,
+        fits_meet,
+        sigma_pos_m: sigma,
+    } = measure_tracks(&shown, &tracks, &options);
+    for line in &unmeasured_spins {
+        super::warn(line);
     }
-    let mut rows = Vec::new();
-    let mut records = Vec::new();
-    for (i, m) in batch.measured {
-        let t = &tracks[i];
-        let row = Row {
-            id: t.id.clone(),
-            d1_mm: t.d1_m * 1e3,
-            d2_mm: t.d2_m * 1e3,
-            m,
-        };
-        // A number is right or it is an error: a collision whose numbers overflowed (absurd
-        // magnitudes in the tracks or flags) is unmeasurable, not printed as NaN.
-        if let Some((col, v)) = COLUMNS
-            .iter()
-            .zip(row.cells())
-            .find(|(c, v)| **c != "collision" && (v == "NaN" || v.ends_with("inf")))
-        {
-            skipped.push((
-                i,
-                format!(
-                    "{}: {col} = {v} (the tracks or flags are out of range)",
-                    place(t)
-                ),
-            ));
-            continue;
-        }
-        records.push(CollisionRecord {
-            line: t.first_line,
-            id: Some(t.id.clone()),
-            pre: row.m.pre,
-            post: row.m.post,
-        });
-        rows.push(row);
-    }
-    skipped.sort_by_key(|(i, _)| *i);
-    let skipped: Vec<String> = skipped.into_iter().map(|(_, s)| s).collect();
     if !skipped.is_empty() {
         if args.strict || rows.is_empty() {
             return Err(skipped[0].clone());
@@ -199,10 +151,9 @@ pub fn run(args: Args) -> CliResult {
             ));
         }
     }
-    let fallbacks: Vec<String> = rows
+    let fallbacks: Vec<String> = fits_meet
         .iter()
-        .filter(|r| r.m.kinematics.time_rule != restitution::kinematics::TimeRule::ContactDistance)
-        .map(|r| restitution::data::shown(&r.id))
+        .map(|id| restitution::data::shown(id))
         .collect();
     if !fallbacks.is_empty() {
         super::warn(format_args!(

@@ -66,13 +66,18 @@ fn read_json(path: &Path) -> Result<(String, Value), DataError> {
     let shown = path.display().to_string();
     let text =
         std::fs::read_to_string(path).map_err(|e| err(&shown, format!("cannot read: {e}")))?;
-    let v: Value = serde_json::from_str(&text).map_err(|e| DataError {
-        path: shown.clone(),
+    parse_json(&shown, &text)
+}
+
+/// Parses JSON text that `name` stands for in messages.
+fn parse_json(name: &str, text: &str) -> Result<(String, Value), DataError> {
+    let v: Value = serde_json::from_str(text).map_err(|e| DataError {
+        path: name.to_string(),
         line: Some(e.line()),
         column: None,
         message: format!("not valid JSON (column {}): {e}", e.column()),
     })?;
-    Ok((shown, v))
+    Ok((name.to_string(), v))
 }
 
 /// The value at a dotted path of keys, or an error naming the path.
@@ -101,6 +106,17 @@ fn number(path: &str, v: &Value, keys: &str) -> Result<f64, DataError> {
 /// Reads a params.json (see [`FitParamsFile`]).
 pub fn read_params_json(path: &Path) -> Result<FitParamsFile, DataError> {
     let (p, v) = read_json(path)?;
+    params_from_value(p, v)
+}
+
+/// A params.json document given as text (`name` stands for it in messages), as
+/// [`read_params_json`] reads it from a file.
+pub fn parse_params_json(name: &str, text: &str) -> Result<FitParamsFile, DataError> {
+    let (p, v) = parse_json(name, text)?;
+    params_from_value(p, v)
+}
+
+fn params_from_value(p: String, v: Value) -> Result<FitParamsFile, DataError> {
     let p = p.as_str();
     let material = Material::new(
         number(p, &v, "material.youngs_pa")?,
@@ -248,6 +264,16 @@ impl FitParamsFile {
 /// Reads e, beta_0 and mu_0 from a walton.json (see [`WaltonParams`]).
 pub fn read_walton_json(path: &Path) -> Result<WaltonParams, DataError> {
     let (p, v) = read_json(path)?;
+    walton_from_value(p, v)
+}
+
+/// A walton.json document given as text (`name` stands for it in messages).
+pub fn parse_walton_json(name: &str, text: &str) -> Result<WaltonParams, DataError> {
+    let (p, v) = parse_json(name, text)?;
+    walton_from_value(p, v)
+}
+
+fn walton_from_value(p: String, v: Value) -> Result<WaltonParams, DataError> {
     let p = p.as_str();
     let e = number(p, &v, "e.value")?;
     let mu0 = number(p, &v, "mu0.value")?;

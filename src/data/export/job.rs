@@ -8,7 +8,10 @@ use super::files::{self, verify_table};
 use super::lammps::Friction;
 use super::plan::{self, EngineKind, LawChoice};
 use super::run::{self, VerifyRow};
-use super::{read_params_json, read_walton_json, report};
+use super::{
+    FitParamsFile, WaltonParams, parse_params_json, parse_walton_json, read_params_json,
+    read_walton_json, report,
+};
 use crate::contact::Material;
 use crate::data::fmt_num;
 use crate::dem::law::FittedCurve;
@@ -66,6 +69,30 @@ impl From<super::super::DataError> for ExportError {
     }
 }
 
+/// A JSON document (params.json, walton.json): a file, or text held in memory with the name
+/// messages give it.
+#[derive(Debug, Clone, Copy)]
+pub enum JsonSource<'a> {
+    Path(&'a Path),
+    Text { name: &'a str, text: &'a str },
+}
+
+impl JsonSource<'_> {
+    fn params(self) -> Result<FitParamsFile, ExportError> {
+        Ok(match self {
+            JsonSource::Path(p) => read_params_json(p)?,
+            JsonSource::Text { name, text } => parse_params_json(name, text)?,
+        })
+    }
+
+    fn walton(self) -> Result<(WaltonParams, String), ExportError> {
+        Ok(match self {
+            JsonSource::Path(p) => (read_walton_json(p)?, p.display().to_string()),
+            JsonSource::Text { name, text } => (parse_walton_json(name, text)?, name.to_string()),
+        })
+    }
+}
+
 /// The fitted law to export, with the material and sphere sizes it was fitted for.
 #[derive(Debug, Clone)]
 pub struct FittedLaw {
@@ -82,8 +109,8 @@ pub struct FittedLaw {
 impl FittedLaw {
     /// The law of a params.json written by `restitution fit --out`: the preferred model, or
     /// `model`.
-    pub fn from_params(path: &Path, model: Option<&str>) -> Result<FittedLaw, ExportError> {
-        let file = read_params_json(path)?;
+    pub fn from_params(params: JsonSource, model: Option<&str>) -> Result<FittedLaw, ExportError> {
+        let file = params.params()?;
         let (curve, entry) = file.curve(model)?;
         let mut warnings = Vec::new();
         if entry.converged == Some(false) {
@@ -150,11 +177,8 @@ impl FittedLaw {
             curve,
             material,
             diameters_mm: Vec::new(),
-            source: match style {
-                ArgStyle::Flags => "command-line flags",
-                ArgStyle::Keywords => "keyword arguments",
-            }
-            .into(),
+            // Worded alike for every front end, so the files do not depend on which one ran.
+            source: "the numbers given".into(),
             warnings: Vec::new(),
         })
     }
@@ -163,7 +187,7 @@ impl FittedLaw {
 /// The friction of the exported scene, from a walton.json or given, and its warnings.
 pub fn friction(
     style: ArgStyle,
-    walton: Option<&Path>,
+    walton: Option<JsonSource>,
     mu0: Option<f64>,
     beta0: Option<f64>,
 ) -> Result<(Option<Friction>, Vec<String>), ExportError> {
@@ -175,16 +199,16 @@ pub fn friction(
         )
         .into()),
         (Some(w), None) => {
-            let wp = read_walton_json(w)?;
+            let (wp, w) = w.walton()?;
             let mut warnings = Vec::new();
             if !wp.converged {
-                warnings.push(format!("{}: the Walton fit did not converge", w.display()));
+                warnings.push(format!("{w}: the Walton fit did not converge"));
             }
             Ok((
                 Some(Friction {
                     mu0: wp.mu0,
                     beta0: Some(wp.beta0),
-                    source: format!("from {}", w.display()),
+                    source: format!("from {w}"),
                 }),
                 warnings,
             ))
@@ -212,7 +236,7 @@ pub fn friction(
                 Some(Friction {
                     mu0: mu,
                     beta0,
-                    source: format!("from {}", style.name("mu0")),
+                    source: "given".into(),
                 }),
                 Vec::new(),
             ))

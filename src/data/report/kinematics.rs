@@ -1,8 +1,12 @@
 //! The documents of `restitution kinematics`: `kinematics.csv` (one row per measured collision),
-//! its JSON form, and `fit_input.csv` (the `restitution fit` schema), built by the library.
+//! its JSON form, and `fit_input.csv` (the `restitution fit` schema), built by the library; and
+//! the pass that measures a tracks file for them ([`measure_tracks`]).
 
+use crate::data::tracks::CollisionTrack;
 use crate::data::{CsvOut, fmt_num};
-use crate::kinematics::Measurement;
+use crate::fit::walton::CollisionRecord;
+use crate::kinematics::batch::{BatchOptions, CollisionInput, measure_batch};
+use crate::kinematics::{Measurement, TimeRule};
 
 /// The columns of `kinematics.csv` (and the keys of each JSON record).
 pub const COLUMNS: [&str; 27] = [
@@ -35,6 +39,7 @@ pub const COLUMNS: [&str; 27] = [
     "d2_mm",
 ];
 
+#[derive(Debug, Clone)]
 pub struct Row {
     pub id: String,
     pub d1_mm: f64,
@@ -144,4 +149,101 @@ pub fn kinematics_json(rows: &[Row]) -> String {
         })
         .collect();
     serde_json::to_string_pretty(&list).expect("JSON values serialise") + "\n"
+}
+
+/// The whole `kinematics` pass over a tracks file, as the command line and Python run it: every
+/// collision measured with the noise pooled over all of them ([`measure_batch`]), the rows in
+/// the file's order, and every collision that could not be measured named with its place.
+#[derive(Debug)]
+pub struct Measured {
+    pub rows: Vec<Row>,
+    /// Each measured collision as an oblique-collision record (walton_input.csv).
+    pub records: Vec<CollisionRecord>,
+    /// The position noise pooled over every collision, m.
+    pub sigma_pos_m: f64,
+    /// `FILE:LINE: collision 'ID': why`, in the file's order.
+    pub skipped: Vec<String>,
+    /// `FILE:LINE: collision 'ID': w1z_rad_s, ... not measured (empty): taken as 0 in beta and
+    /// psi`.
+    pub unmeasured_spins: Vec<String>,
+    /// Ids of the collisions whose time is where the pre- and post-collision fits meet (they
+    /// never reach contact distance on the pre-collision fits).
+    pub fits_meet: Vec<String>,
+}
+
+/// Measures every collision of `tracks` (read from `shown`). A collision whose numbers
+/// overflow (absurd magnitudes in the tracks or options) is skipped like an unmeasurable one,
+/// never reported as NaN or inf.
+pub fn measure_tracks(shown: &str, tracks: &[CollisionTrack], options: &BatchOptions) -> Measured {
+    let place = |t: &CollisionTrack| {
+        format!(
+            "{shown}:{}: collision '{}'",
+            t.first_line,
+            crate::data::shown(&t.id)
+        )
+    };
+    let inputs: Vec<CollisionInput> = tracks.iter().map(|t| t.input()).collect();
+    let batch = measure_batch(&inputs, options);
+    let mut skipped: Vec<(usize, String)> = batch
+        .skipped
+        .iter()
+        .map(|(i, e)| (*i, format!("{}: {e}", place(&tracks[*i]))))
+        .collect();
+    let unmeasured_spins = batch
+        .unmeasured_spins
+        .iter()
+        .map(|(i, names)| {
+            format!(
+                "{}: {} not measured (empty): taken as 0 in beta and psi",
+                place(&tracks[*i]),
+                names.join(", ")
+            )
+        })
+        .collect();
+    let mut rows = Vec::new();
+    let mut records = Vec::new();
+    for (i, m) in batch.measured {
+        let t = &tracks[i];
+        let row = Row {
+            id: t.id.clone(),
+            d1_mm: t.d1_m * 1e3,
+            d2_mm: t.d2_m * 1e3,
+            m,
+        };
+        if let Some((col, v)) = COLUMNS
+            .iter()
+            .zip(row.cells())
+            .find(|(c, v)| **c != "collision" && (v == "NaN" || v.ends_with("inf")))
+        {
+            skipped.push((
+                i,
+                format!(
+                    "{}: {col} = {v} (the tracks or flags are out of range)",
+                    place(t)
+                ),
+            ));
+            continue;
+        }
+        records.push(CollisionRecord {
+            line: t.first_line,
+            id: Some(t.id.clone()),
+            pre: row.m.pre,
+            post: row.m.post,
+        });
+        rows.push(row);
+    }
+    skipped.sort_by_key(|(i, _)| *i);
+    let fits_meet = rows
+        .iter()
+        .filter(|r| r.m.kinematics.time_rule != TimeRule::ContactDistance)
+        .map(|r| r.id.clone())
+        .collect();
+    Measured {
+        rows,
+        records,
+        sigma_pos_m: batch.sigma_pos_m,
+        skipped: skipped.into_iter().map(|(_, s)| s).collect(),
+        unmeasured_spins,
+        fits_meet,
+    }
 }
