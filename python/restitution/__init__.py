@@ -10,7 +10,7 @@ behind the ``restitution`` command line directly, so every number is the command
 >>> r.preferred, r.params["min"]["eta"], r.table()
 
 Functions: :func:`predict`, :func:`e_of_kappa`, :func:`e_of_u`, :func:`fit`,
-:func:`walton_fit`, :func:`kinematics`, :func:`export`. Units are in argument and column names (``v_m_s``,
+:func:`walton_fit`, :func:`kinematics`, :func:`track`, :func:`export`. Units are in argument and column names (``v_m_s``,
 ``d_mm``, ``sigma_y_pa``), SI otherwise. Bad input raises :class:`InputError` (a ValueError)
 with the command line's one-line message; a numerical method that gives up raises
 :class:`NumericalError` (a RuntimeError). Long calls release the GIL.
@@ -21,6 +21,7 @@ from ._models import DEFAULT_TOL, e_of_kappa, e_of_u, predict
 from ._fit import FIT_COLUMNS, DataWarning, FitResult, fit
 from ._walton import KinematicsResult, WaltonResult, kinematics, walton_fit
 from ._export import VERIFY_TOLERANCE, ExportResult, export
+from ._track import TrackResult, track
 
 __all__ = [
     "DEFAULT_TOL",
@@ -31,6 +32,7 @@ __all__ = [
     "InputError",
     "KinematicsResult",
     "NumericalError",
+    "TrackResult",
     "WaltonResult",
     "e_of_kappa",
     "e_of_u",
@@ -39,6 +41,7 @@ __all__ = [
     "kinematics",
     "material_presets",
     "predict",
+    "track",
     "VERIFY_TOLERANCE",
     "walton_fit",
 ]

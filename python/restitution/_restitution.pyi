@@ -134,3 +134,12 @@ def export(
     out: Optional[Union[str, PathLike[str]]] = ...,
     verify: bool = ...,
 ) -> Dict[str, Any]: ...
+
+def track(
+    dirs: List[str],
+    fps: float,
+    pixel_m: Optional[float] = ...,
+    d_mm: Optional[List[float]] = ...,
+    out: Optional[Union[str, PathLike[str]]] = ...,
+    strict: bool = ...,
+) -> Dict[str, Any]: ...

@@ -22,6 +22,7 @@ mod export;
 mod fit;
 mod kinematics;
 mod models;
+mod track;
 mod walton;
 
 create_exception!(
@@ -208,5 +209,6 @@ fn _restitution(m: &Bound<'_, PyModule>) -> PyResult<()> {
     walton::register(m)?;
     kinematics::register(m)?;
     export::register(m)?;
+    track::register(m)?;
     Ok(())
 }

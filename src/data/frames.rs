@@ -2,6 +2,8 @@
 //! writing tracks.csv (the `kinematics` schema), detections.csv, spins.csv, collisions.csv and
 //! the JSON form of all of it. Numbers in shortest round-trip form; CSV through csv::Writer.
 
+pub mod job;
+
 use super::images::{list_frames, read_gray};
 use super::tracks::{CollisionTrack, write_tracks};
 use super::{DataError, fmt_num};
@@ -389,4 +391,9 @@ pub fn results_json(results: &[CollisionResult]) -> Value {
             })
             .collect(),
     )
+}
+
+/// [`results_json`] as the text `track --format json` prints.
+pub fn results_json_text(results: &[CollisionResult]) -> String {
+    serde_json::to_string_pretty(&results_json(results)).expect("JSON values serialise") + "\n"
 }

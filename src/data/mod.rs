@@ -27,6 +27,23 @@ pub use write::{CsvOut, write_all_atomic, write_atomic};
 
 use std::fmt;
 
+/// How a message names an argument: `--v-range` on the command line, `v_range` in Python.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ArgStyle {
+    Flags,
+    Keywords,
+}
+
+impl ArgStyle {
+    /// The argument `key` (snake_case) as the user typed it.
+    pub fn name(self, key: &str) -> String {
+        match self {
+            ArgStyle::Flags => format!("--{}", key.replace('_', "-")),
+            ArgStyle::Keywords => key.to_string(),
+        }
+    }
+}
+
 /// An input error pointing at a place in a file.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DataError {

@@ -13,6 +13,7 @@ use super::{
     read_walton_json, report,
 };
 use crate::contact::Material;
+pub use crate::data::ArgStyle;
 use crate::data::fmt_num;
 use crate::dem::law::FittedCurve;
 use crate::dem::range::{SpeedRange, Weight};
@@ -28,23 +29,6 @@ use std::path::Path;
 pub const VERIFY_TOLERANCE: f64 = 1e-6;
 /// Steps per shortest contact of the round trip's ladder (first-order error in e: Richardson).
 pub const LADDER: [u32; 3] = [4000, 8000, 16000];
-
-/// How a message names an argument: `--v-range` on the command line, `v_range` in Python.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ArgStyle {
-    Flags,
-    Keywords,
-}
-
-impl ArgStyle {
-    /// The argument `key` (snake_case) as the user typed it.
-    pub fn name(self, key: &str) -> String {
-        match self {
-            ArgStyle::Flags => format!("--{}", key.replace('_', "-")),
-            ArgStyle::Keywords => key.to_string(),
-        }
-    }
-}
 
 /// Why an export did not happen. Nothing is written in either case.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

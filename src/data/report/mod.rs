@@ -5,4 +5,5 @@ pub mod camera_study;
 pub mod fit;
 pub mod fit_text;
 pub mod kinematics;
+pub mod track;
 pub mod walton;
