@@ -203,13 +203,29 @@ fn bad_inputs_fail_with_one_line_naming_the_file() {
     assert_fails_naming(&call(&three), "3 sphere-sized blobs", &out);
     // Bad numbers.
     let c = write_collision(&root, "good");
-    for (flag, val) in [("--fps", "0"), ("--fps", "nan"), ("--d-mm", "-3")] {
+    // Out of range: a subnormal frame rate made every t_s infinite (printed as null), a
+    // diameter of 1e300 mm the scale's uncertainty; now each is an error naming the flag and
+    // its value in shortest form.
+    for (flag, val) in [
+        ("--fps", "0"),
+        ("--fps", "NaN"),
+        ("--d-mm", "-3"),
+        ("--fps", "5e-324"),
+        ("--fps", "1e300"),
+        ("--d-mm", "1e300"),
+    ] {
         let mut a = with(&c);
         let i = a.iter().position(|x| x == flag).unwrap();
         a[i + 1] = val.to_string();
         let r = run(&a.iter().map(String::as_str).collect::<Vec<_>>());
-        assert_fails_naming(&r, flag, &out);
+        assert_fails_naming(&r, &format!("{flag} {val}"), &out);
     }
+    let r = run(&["track", &s(&c), "--fps", "1000", "--pixel-m", "1e300"]);
+    assert!(
+        !r.ok && r.stderr.contains("--pixel-m 1e300: expected 1e-12 to 1 m"),
+        "{}",
+        r.stderr
+    );
     // Neither a pixel size nor diameters.
     let r = run(&["track", &s(&c), "--fps", "1000"]);
     assert!(!r.ok && r.stderr.contains("--pixel-m"), "{}", r.stderr);

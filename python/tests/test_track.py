@@ -55,10 +55,11 @@ def test_a_single_directory_and_a_pixel_size(frames):
 @pytest.mark.parametrize(
     "kwargs,message",
     [
-        (dict(fps=-1.0, d_mm=12.7), "fps must be a positive number, got -1"),
+        (dict(fps=-1.0, d_mm=12.7), "fps -1: expected a positive number"),
         (dict(fps=1000.0), "the scale is missing: give pixel_m P"),
         (dict(fps=1000.0, d_mm=[1.0, 2.0, 3.0]), "d_mm takes one or two diameters"),
-        (dict(fps=1e300, d_mm=12.7, pixel_m=float("inf")), "pixel_m must be a positive number, got inf"),
+        (dict(fps=5e-324, d_mm=12.7), "fps 5e-324: expected 1e-6 to 10000000000 frames per second"),
+        (dict(fps=1000.0, d_mm=12.7, pixel_m=float("inf")), "pixel_m inf: expected a positive number"),
     ],
 )
 def test_bad_arguments_name_the_keyword(frames, kwargs, message):

@@ -2,6 +2,7 @@
 //! arguments struct and a `run` that parses, calls the library and prints.
 
 use restitution::contact::{Material, PRESETS};
+use restitution::data::fmt_num;
 use std::io::{self, Write};
 
 pub mod bench;
@@ -85,7 +86,7 @@ impl MaterialArgs {
                     ),
                 ] {
                     if !ok {
-                        return Err(format!("{flag} {v}: expected {expected}"));
+                        return Err(format!("{flag} {}: expected {expected}", fmt_num(v)));
                     }
                 }
                 Material::new(y, nu, rho)

@@ -113,7 +113,7 @@ fn run_fit(a: FitArgs) -> CliResult {
     if !(a.inertia_k.is_finite() && a.inertia_k > 0.0 && a.inertia_k <= 1.0) {
         return Err(format!(
             "--inertia-k {}: expected a number in (0, 1] (K = 4I/(m d^2); 0.4 for a homogeneous sphere)",
-            a.inertia_k
+            restitution::data::fmt_num(a.inertia_k)
         ));
     }
     if a.bootstrap == 1 {

@@ -9,6 +9,13 @@ use crate::frames::spin::Spin;
 use crate::frames::track::{CollisionResult, TrackSettings, assemble};
 use std::path::PathBuf;
 
+/// Accepted frame rates, frames per second.
+pub const FPS_RANGE: (f64, f64) = (1e-6, 1e10);
+/// Accepted pixel sizes in the object plane, m.
+pub const PIXEL_M_RANGE: (f64, f64) = (1e-12, 1.0);
+/// Accepted sphere diameters, mm (as `export` accepts).
+pub const D_MM_RANGE: (f64, f64) = (1e-3, 1e4);
+
 /// What a `track` run needs besides the directories, as the user gave it.
 #[derive(Debug, Clone)]
 pub struct TrackRequest {
@@ -32,18 +39,44 @@ impl TrackRequest {
                 Ok(v)
             } else {
                 Err(format!(
-                    "{} must be a positive number, got {}",
+                    "{} {}: expected a positive number",
                     name(k),
                     fmt_num(v)
                 ))
             }
         };
-        let fps = positive("fps", self.fps)?;
-        let pixel_m = self.pixel_m.map(|p| positive("pixel_m", p)).transpose()?;
+        // Ranges wide enough for any camera and sphere, narrow enough that no time, position,
+        // speed or scale uncertainty derived from them can overflow (a number or an error).
+        let within = |k: &str, v: f64, lo: f64, hi: f64, unit: &str| {
+            let v = positive(k, v)?;
+            if (lo..=hi).contains(&v) {
+                Ok(v)
+            } else {
+                Err(format!(
+                    "{} {}: expected {} to {} {unit}",
+                    name(k),
+                    fmt_num(v),
+                    fmt_num(lo),
+                    fmt_num(hi)
+                ))
+            }
+        };
+        let fps = within(
+            "fps",
+            self.fps,
+            FPS_RANGE.0,
+            FPS_RANGE.1,
+            "frames per second",
+        )?;
+        let pixel_m = self
+            .pixel_m
+            .map(|p| within("pixel_m", p, PIXEL_M_RANGE.0, PIXEL_M_RANGE.1, "m"))
+            .transpose()?;
+        let d = |v: f64| within("d_mm", v, D_MM_RANGE.0, D_MM_RANGE.1, "mm").map(|d| d * 1e-3);
         let d_m = match self.d_mm.as_deref() {
             None => None,
-            Some([d]) => Some([positive("d_mm", *d)? * 1e-3; 2]),
-            Some([d1, d2]) => Some([positive("d_mm", *d1)? * 1e-3, positive("d_mm", *d2)? * 1e-3]),
+            Some([d1]) => Some([d(*d1)?; 2]),
+            Some([d1, d2]) => Some([d(*d1)?, d(*d2)?]),
             Some(_) => return Err(format!("{} takes one or two diameters", name("d_mm"))),
         };
         if pixel_m.is_none() && d_m.is_none() {
