@@ -41,7 +41,11 @@ fn main() {
                     Some("predict") => Command::Predict,
                     Some("simulate") => Command::Simulate,
                     Some("bench") => Command::Bench,
-                    _ => fail("--command: fit, walton, kinematics, predict, simulate or bench"),
+                    Some("export") => Command::Export,
+                    Some("track") => Command::Track,
+                    _ => fail(
+                        "--command: fit, walton, kinematics, predict, simulate, bench, export or track",
+                    ),
                 })
             }
             other => fail(&format!("unknown argument '{other}'")),

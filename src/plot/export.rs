@@ -231,7 +231,7 @@ fn legend_row(
             RGBColor(120, 120, 120).mix(0.2).filled(),
         ))
         .map_err(err)?;
-        let label = format!("tolerance ±{t}");
+        let label = format!("tolerance ±{}", crate::error::Num(t));
         area.draw(&Text::new(label, (x + 38, y - 9), font.clone()))
             .map_err(err)?;
     }

@@ -376,6 +376,8 @@ pub enum Command {
     Predict,
     Simulate,
     Bench,
+    Export,
+    Track,
 }
 
 /// The `i`-th case of `command` in a seeded run (each case its own stream of choices).
@@ -392,6 +394,8 @@ pub fn case_of(command: Command, seed: u64, i: u64, fit_base: &Sheet, big_rows: 
         Command::Predict => predict_case(&mut rng),
         Command::Simulate => simulate_case(&mut rng),
         Command::Bench => bench_case(&mut rng),
+        Command::Export => export_case(&mut rng),
+        Command::Track => track_case(&mut rng),
     };
     c.label = format!("{command:?} case {i} (seed {seed}) {}", c.label);
     c
@@ -399,13 +403,269 @@ pub fn case_of(command: Command, seed: u64, i: u64, fit_base: &Sheet, big_rows: 
 
 /// The `i`-th case of a seeded run over every subcommand in turn.
 pub fn case(seed: u64, i: u64, fit_base: &Sheet, big_rows: bool) -> Case {
-    let command = match i % 12 {
+    let command = match i % 14 {
         0..=3 => Command::Fit,
         4..=5 => Command::Walton,
         6..=7 => Command::Kinematics,
         8..=9 => Command::Predict,
         10 => Command::Simulate,
+        11 => Command::Export,
+        12 => Command::Track,
         _ => Command::Bench,
     };
     case_of(command, seed, i, fit_base, big_rows)
+}
+
+/// The shipped fit's params.json, the valid input that export cases mutate.
+const PARAMS_JSON: &str = include_str!("../../reports/fit/params.json");
+/// The shipped Walton fit's walton.json.
+const WALTON_JSON: &str = include_str!("../../reports/walton/walton.json");
+
+/// A JSON document with one of its numbers replaced by an extreme value, or cut short, or with
+/// bytes that are not UTF-8.
+fn mutate_json(rng: &mut StdRng, doc: &str) -> Vec<u8> {
+    match rng.random_range(0..8) {
+        0 => doc.as_bytes()[..rng.random_range(0..doc.len())].to_vec(),
+        1 => {
+            let mut b = doc.as_bytes().to_vec();
+            let at = rng.random_range(0..b.len());
+            b[at] = 0xFF;
+            b
+        }
+        2 => doc.as_bytes().to_vec(),
+        _ => {
+            // A number token: a digit after ':', ' ', '[' or '-' up to the next ',', ']', '}' or
+            // line break.
+            let starts: Vec<usize> = doc
+                .char_indices()
+                .filter(|&(i, c)| {
+                    c.is_ascii_digit() && i > 0 && b": [-".contains(&doc.as_bytes()[i - 1])
+                })
+                .map(|(i, _)| i)
+                .collect();
+            let Some(&s) = starts.choose(rng) else {
+                return doc.as_bytes().to_vec();
+            };
+            let s = if doc.as_bytes()[s - 1] == b'-' {
+                s - 1
+            } else {
+                s
+            };
+            let e = s + doc[s..]
+                .find([',', ']', '}', '\n'])
+                .unwrap_or(doc.len() - s);
+            let v = pick(
+                rng,
+                &[
+                    "1e300", "-1e300", "0", "5e-324", "1e-300", "-1", "\"x\"", "null",
+                ],
+            );
+            format!("{}{}{}", &doc[..s], v, &doc[e..]).into_bytes()
+        }
+    }
+}
+
+/// An `export` case: the shipped params.json (mutated or not) or the law as flags, with the
+/// scene's flags drawn typical or extreme. No --verify (it needs LAMMPS and takes seconds).
+pub fn export_case(rng: &mut StdRng) -> Case {
+    let mut args: Vec<String> = vec!["export".into()];
+    let mut files = Vec::new();
+    let from_file = rng.random_bool(0.5);
+    if from_file {
+        args.push("params.json".into());
+        files.push(("params.json".to_string(), mutate_json(rng, PARAMS_JSON)));
+        if rng.random_bool(0.3) {
+            args.extend([
+                "--model".into(),
+                pick(rng, &["vm", "pm", "min", "product", "powerlaw", "nope"]),
+            ]);
+        }
+    } else {
+        args.extend(material(rng));
+        let model = pick(rng, &["vm", "pm", "min", "product", ""]);
+        if !model.is_empty() {
+            args.extend(["--model".into(), model]);
+        }
+        if rng.random_bool(0.7) {
+            flag(&mut args, "--eta", flag_value(rng, &["190", "2000"]));
+        }
+        if rng.random_bool(0.5) {
+            flag(&mut args, "--sigma-y-pa", flag_value(rng, &["4e7"]));
+        }
+        if rng.random_bool(0.3) {
+            args.extend(["--contact-end".into(), pick(rng, &["overlap", "force"])]);
+        }
+    }
+    if !from_file || rng.random_bool(0.3) {
+        let n = rng.random_range(1..=3);
+        let d: Vec<String> = (0..n)
+            .map(|_| flag_value(rng, &["6.35", "12.7", "25.4"]))
+            .collect();
+        flag(&mut args, "--d-mm", d.join(","));
+    }
+    args.extend([
+        "--engine".into(),
+        pick(rng, &["lammps", "constant-e", "table"]),
+    ]);
+    if rng.random_bool(0.7) {
+        let lo = flag_value(rng, &["0.5", "1"]);
+        let hi = flag_value(rng, &["40", "2"]);
+        flag(&mut args, "--v-range", format!("{lo},{hi}"));
+    }
+    if rng.random_bool(0.3) {
+        args.push("--wall".into());
+    }
+    if rng.random_bool(0.2) {
+        flag(&mut args, "--tolerance", flag_value(rng, &["0.01", "0.1"]));
+    }
+    if rng.random_bool(0.2) {
+        flag(
+            &mut args,
+            "--table-points",
+            pick(rng, &["2", "41", "1000", "0", "1", "100001", "-3"]),
+        );
+    }
+    if rng.random_bool(0.2) {
+        let n = rng.random_range(1..=3);
+        let v: Vec<String> = (0..n)
+            .map(|_| flag_value(rng, &["0.5", "3", "20"]))
+            .collect();
+        flag(&mut args, "--speeds", v.join(","));
+    }
+    match rng.random_range(0..5) {
+        0 => {
+            args.extend(["--walton".into(), "walton.json".into()]);
+            files.push(("walton.json".to_string(), mutate_json(rng, WALTON_JSON)));
+        }
+        1 => {
+            flag(&mut args, "--mu0", flag_value(rng, &["0.175", "0"]));
+            if rng.random_bool(0.5) {
+                flag(&mut args, "--beta0", flag_value(rng, &["0.5", "-1", "1"]));
+            }
+        }
+        _ => {}
+    }
+    if rng.random_bool(0.2) {
+        args.extend(["--weight".into(), pick(rng, &["log", "uniform"])]);
+    }
+    if rng.random_bool(0.2) {
+        args.extend([
+            "--law".into(),
+            pick(rng, &["auto", "viscoelastic", "constant-e"]),
+        ]);
+    }
+    let out_dir = rng.random_bool(0.6);
+    if out_dir {
+        args.extend(["--out".into(), "{dir}/out".into()]);
+    }
+    Case {
+        label: format!(
+            "export: {}",
+            if from_file { "params.json" } else { "flags" }
+        ),
+        args,
+        files,
+        out_dir,
+    }
+}
+
+/// An 8-bit grey PNG of two bright discs (radius `r` px, soft 1-px edges) on a dark
+/// background, in memory.
+fn disc_png(w: u32, h: u32, discs: &[([f64; 2], f64)]) -> Vec<u8> {
+    let img = image::GrayImage::from_fn(w, h, |x, y| {
+        let mut v = 20.0;
+        for &([cx, cy], r) in discs {
+            let d = ((x as f64 + 0.5 - cx).powi(2) + (y as f64 + 0.5 - cy).powi(2)).sqrt();
+            v += 200.0 * (r - d + 0.5).clamp(0.0, 1.0);
+        }
+        image::Luma([v.min(255.0) as u8])
+    });
+    let mut bytes = Vec::new();
+    img.write_to(
+        &mut std::io::Cursor::new(&mut bytes),
+        image::ImageFormat::Png,
+    )
+    .expect("PNG encodes in memory");
+    bytes
+}
+
+/// A `track` case: one or two directories of frames of two discs closing in, then mutations
+/// (a corrupt, blank, resized or three-disc frame, a file without a frame number, an empty
+/// directory) and flags drawn typical or extreme.
+pub fn track_case(rng: &mut StdRng) -> Case {
+    let mut args: Vec<String> = vec!["track".into()];
+    let mut files = Vec::new();
+    let n_dirs = rng.random_range(1..=2);
+    let (w, h, r) = (96, 80, 14.0);
+    for k in 0..n_dirs {
+        let dir = format!("c{}", k + 1);
+        let n = rng.random_range(2..=8);
+        for i in 0..n {
+            let t = i as f64 / n as f64;
+            let discs = [
+                ([20.0 + 25.0 * t, 40.0 + 3.0 * t], r),
+                ([76.0 - 25.0 * t, 38.0 - 2.0 * t], r),
+            ];
+            files.push((
+                format!("{dir}/frame{:03}.png", 10 + i),
+                disc_png(w, h, &discs),
+            ));
+        }
+        args.push(dir);
+    }
+    let at = rng.random_range(0..files.len());
+    match rng.random_range(0..9) {
+        0 => {
+            let b = &mut files[at].1;
+            b.truncate(rng.random_range(0..b.len()));
+        }
+        1 => files[at].1 = disc_png(w, h, &[]),
+        2 => files[at].1 = disc_png(w + 7, h, &[([30.0, 40.0], r), ([70.0, 40.0], r)]),
+        3 => {
+            files[at].1 = disc_png(
+                w,
+                h,
+                &[([15.0, 40.0], r), ([48.0, 40.0], r), ([81.0, 40.0], r)],
+            )
+        }
+        4 => files.push(("c1/notes.png".into(), disc_png(w, h, &[]))),
+        5 => files.retain(|(n, _)| !n.starts_with("c1/")),
+        6 => files[at].1 = vec![0xFF; 64],
+        _ => {}
+    }
+    if files.iter().all(|(n, _)| !n.starts_with("c1/")) {
+        // The directory must exist to be empty rather than missing.
+        files.push(("c1/readme.txt".into(), b"no frames here".to_vec()));
+    }
+    flag(&mut args, "--fps", flag_value(rng, &["1000", "5000"]));
+    match rng.random_range(0..4) {
+        0 => flag(&mut args, "--pixel-m", flag_value(rng, &["2.5e-4", "1e-3"])),
+        1 => {
+            flag(&mut args, "--pixel-m", flag_value(rng, &["2.5e-4"]));
+            flag(&mut args, "--d-mm", flag_value(rng, &["7", "12.7"]));
+        }
+        2 => {
+            let d1 = flag_value(rng, &["7", "12.7"]);
+            let d2 = flag_value(rng, &["7", "6"]);
+            flag(&mut args, "--d-mm", format!("{d1},{d2}"));
+        }
+        _ => flag(&mut args, "--d-mm", flag_value(rng, &["7", "12.7"])),
+    }
+    if rng.random_bool(0.2) {
+        args.push("--strict".into());
+    }
+    args.extend(["--format".into(), pick(rng, &["table", "csv", "json"])]);
+    let out_dir = rng.random_bool(0.5);
+    if out_dir {
+        args.extend(["--out".into(), "{dir}/out".into()]);
+    }
+    Case {
+        label: format!(
+            "track: {n_dirs} director{}",
+            if n_dirs == 1 { "y" } else { "ies" }
+        ),
+        args,
+        files,
+        out_dir,
+    }
 }

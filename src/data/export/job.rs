@@ -84,8 +84,11 @@ pub struct FittedLaw {
     pub material: Material,
     /// The fit data's diameters, mm (empty when the law was given as numbers).
     pub diameters_mm: Vec<f64>,
-    /// Where the law came from, for the report and the files' comments.
+    /// Where the law came from, for the report and the files' comments (worded alike for every
+    /// front end, so the files do not depend on which one ran).
     pub source: String,
+    /// The law as the user gave it, for error messages: the file, or the arguments by name.
+    pub shown: String,
     /// What the user should know about it (a fit that did not converge).
     pub warnings: Vec<String>,
 }
@@ -108,6 +111,7 @@ impl FittedLaw {
             material: file.material,
             diameters_mm: file.diameters_mm.clone(),
             source: format!("{} (model {})", file.path, entry.model),
+            shown: format!("{} (model {})", file.path, entry.model),
             warnings,
         })
     }
@@ -161,8 +165,12 @@ impl FittedLaw {
             curve,
             material,
             diameters_mm: Vec::new(),
-            // Worded alike for every front end, so the files do not depend on which one ran.
             source: "the numbers given".into(),
+            shown: [(n_eta.as_str(), eta), (n_sigma.as_str(), sigma_y_pa)]
+                .iter()
+                .filter_map(|(n, v)| v.map(|v| format!("{n} {}", fmt_num(v))))
+                .collect::<Vec<_>>()
+                .join(", "),
             warnings: Vec::new(),
         })
     }
@@ -304,7 +312,15 @@ pub fn export(law: &FittedLaw, o: &ExportOptions) -> Result<Exported, ExportErro
         }
     }
     if let Some(t) = o.tolerance {
-        positive(&name("tolerance"), t)?;
+        // A deviation of e, which lies in [0, 1], is at most 1: a larger tolerance is a typo.
+        if !(t > 0.0 && t <= 1.0) {
+            return Err(format!(
+                "{} {}: expected a deviation of e in (0, 1]",
+                name("tolerance"),
+                fmt_num(t)
+            )
+            .into());
+        }
         if o.v_range.is_none() {
             return Err(format!("{} needs {} LO,HI", name("tolerance"), name("v_range")).into());
         }
@@ -354,7 +370,7 @@ pub fn export(law: &FittedLaw, o: &ExportOptions) -> Result<Exported, ExportErro
         table_points: o.table_points,
         tolerance: o.tolerance,
     })
-    .map_err(|e| format!("{}: {e}", law.source))?;
+    .map_err(|e| format!("{}: {e}", law.shown))?;
     let speeds: Vec<f64> = if o.speeds_m_s.is_empty() {
         plan::default_speeds(o.v_range)
     } else {
@@ -370,7 +386,8 @@ pub fn export(law: &FittedLaw, o: &ExportOptions) -> Result<Exported, ExportErro
         o.friction.as_ref(),
         &speeds,
         &law.source,
-    )?;
+    )
+    .map_err(|e| format!("{}: {e}", law.shown))?;
     let mut outputs = plan.outputs.clone();
     #[cfg(feature = "plot")]
     if tr.request.range.is_some() {
