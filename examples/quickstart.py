@@ -1,8 +1,8 @@
-"""The toolkit from Python, end to end: predict e(v), fit measured e(v_n), Walton's operator and
-tracks to parameters. The numbers are the command line's (the package calls the same library).
+"""The toolkit from Python, end to end: predict e(v), fit measured e(v_n), Walton's operator,
+tracks to parameters and the fitted law as LAMMPS input. The numbers are the command line's (the package calls the same library).
 
     pip install ./python            # once, from the repository root (needs a Rust toolchain)
-    python examples/quickstart.py [--out DIR]   # DIR: where fig7.svg goes (default: none)
+    python examples/quickstart.py [--out DIR]   # DIR: fig7.svg and the LAMMPS files (default: none)
 """
 
 import argparse
@@ -16,7 +16,7 @@ import restitution as rs
 DATA = Path(__file__).resolve().parents[1] / "data"
 
 ap = argparse.ArgumentParser(description="restitution from Python, end to end")
-ap.add_argument("--out", type=Path, help="write fig7.svg of the fit here")
+ap.add_argument("--out", type=Path, help="write fig7.svg of the fit and the LAMMPS files here")
 args = ap.parse_args()
 
 # 1. e(v) of the viscoelastic model for the paper's nylon, 25.4 mm spheres, eta = 190 kg/(s m)
@@ -74,6 +74,17 @@ with warnings.catch_warnings():
 p = chain.params["product"]
 print(f"tracks -> e -> fit: eta = {p['eta']['value']:.0f}, sigma_y = {p['sigma_y']['value']:.3g} Pa"
       f" (planted 190 and 4e7)")
+
+# 5. The fitted law for a simulation (`restitution export`): LAMMPS input for the scene's
+#    sizes and speeds, with the closest law the engine can run and its largest deviation.
+x = rs.export(fit, engine="lammps", v_range=(0.5, 40), tolerance=0.01, walton=w)
+doc = x.to_dict()
+print(f"\nexport for LAMMPS: {sorted(x.files)}; the files carry {doc['lammps']['note']};"
+      f" the simplest law within 0.01 of the fit: {doc['recommendation']['chosen']}")
+if args.out:
+    args.out.mkdir(parents=True, exist_ok=True)
+    for name, data in x.files.items():
+        (args.out / name).write_bytes(data)
 
 # Bad input is a ValueError with the command line's message.
 try:
