@@ -62,13 +62,16 @@ pub const KAPPA_TRUST: f64 = 0.1;
 pub const PADE_KAPPA_MAX: f64 = 100.0;
 
 /// How many terms of the small-kappa series.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, strum::IntoStaticStr)]
 pub enum Series {
     /// 1 - e = C1 kappa.
+    #[strum(serialize = "order 1")]
     Order1,
     /// Every term through kappa^2.
+    #[strum(serialize = "order 2")]
     Order2,
     /// Every term through kappa^3 (for the force rule including -(4/15) kappa^(5/2)).
+    #[strum(serialize = "order 3")]
     Order3,
 }
 
@@ -76,22 +79,21 @@ impl Series {
     pub const ALL: [Series; 3] = [Series::Order1, Series::Order2, Series::Order3];
 
     pub fn name(self) -> &'static str {
-        match self {
-            Series::Order1 => "order 1",
-            Series::Order2 => "order 2",
-            Series::Order3 => "order 3",
-        }
+        self.into()
     }
 }
 
 /// Which Pade approximant (force rule).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, strum::IntoStaticStr)]
 pub enum Pade {
     /// [1/4] with Mueller & Poeschel's printed 6-digit coefficients.
+    #[strum(serialize = "[1/4] Mueller-Poeschel")]
     MullerPoeschel14,
     /// [1/4] with full-precision coefficients (ours).
+    #[strum(serialize = "[1/4] exact coefficients")]
     Exact14,
     /// [1/5] through the kappa^3 term (ours).
+    #[strum(serialize = "[1/5] ours")]
     Ours15,
 }
 
@@ -99,11 +101,7 @@ impl Pade {
     pub const ALL: [Pade; 3] = [Pade::MullerPoeschel14, Pade::Exact14, Pade::Ours15];
 
     pub fn name(self) -> &'static str {
-        match self {
-            Pade::MullerPoeschel14 => "[1/4] Mueller-Poeschel",
-            Pade::Exact14 => "[1/4] exact coefficients",
-            Pade::Ours15 => "[1/5] ours",
-        }
+        self.into()
     }
 
     /// Numerator and denominator coefficients in x = kappa^(1/2), lowest power first.
