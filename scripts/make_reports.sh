@@ -29,6 +29,8 @@ $B kinematics data/virtual/oblique/tracks.csv --material nylon --fixed-gravity \
 $B walton fit reports/kinematics/oblique/walton_input.csv --material nylon \
     --out reports/kinematics/oblique/walton > /dev/null
 $B simulate --material nylon --camera-study --incidence-deg 0,45 --out reports/kinematics > /dev/null
+# The chain's coverage of beta_0 and mu_0 over 30 experiments, fixed-gravity against free fits.
+bash scripts/chain_coverage.sh > /dev/null
 
 # From video frames: a rendered collision tracked (frames in target/, not committed).
 cargo run --release --quiet --example track_demo -- target/frames > /dev/null

@@ -6,8 +6,8 @@
 //! Walton bootstrap measured 92-94%, tests/walton.rs), so a single seed misses about one time in
 //! fifteen; we require at least 6 of 8 (P(fewer | coverage 0.92) = 3%; the outcome is fixed by the
 //! seeds, so the test is deterministic). Measured: eta 8/8, sigma_y 8/8, beta_0 8/8, mu_0 7/8; over
-//! 30 seeds of the oblique scenario beta_0 27/30 and mu_0 28/30, with mu_0 0.24 standard errors
-//! low on average (noise in psi, the abscissa, flattens the fitted slope).
+//! 30 seeds of the oblique scenario (scripts/chain_coverage.sh) beta_0 27/30 and mu_0 28/30, with
+//! mu_0 0.24 standard errors low on average (noise in psi, the abscissa, flattens the fitted slope).
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -317,7 +317,8 @@ fn fixed_gravity_fits_measure_e_several_times_more_precisely() {
     };
     let free = median_error(None);
     let fixed = median_error(Some("--fixed-gravity"));
-    // Measured 3.4x on 1000 collisions; 2x leaves room for this sample's noise.
+    // Measured 3.2x on 1000 collisions (scripts/chain_coverage.sh); 2x leaves room for this
+    // sample's noise.
     assert!(free / fixed > 2.0, "free {free} fixed {fixed}");
 }
 
