@@ -14,6 +14,9 @@ $B fit data/fig7_nylon.csv --material nylon --out reports/fit > /dev/null
 # Walton (issue 5): synthetic oblique collisions like Fig. 6, then the hinge fit.
 cargo run --release --quiet --example gen_oblique_collisions
 $B walton fit data/oblique_collisions.csv --material nylon --out reports/walton > /dev/null
+# Coverage and scatter of the Walton fit over 1000 seeded repetitions, both weightings (about 10 s;
+# the ms-per-fit lines are timings and vary).
+cargo run --release --quiet --example walton_coverage -- 1000 1000 60 > reports/walton/coverage.txt
 
 # Kinematics (issue 6): two virtual experiments through the whole chain, and the camera study.
 $B simulate --material nylon --out data/virtual/normal --n 150 --seed 1 --d-mm 12.7 \
