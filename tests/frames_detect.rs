@@ -38,8 +38,12 @@ fn two() -> Vec<common::synth::Ball> {
     vec![ball([52.3, 150.6], 40.0, 12), ball([140.2, 80.4], 40.0, 12)]
 }
 
-fn worst(e: &[f64]) -> f64 {
-    e.iter().copied().fold(0.0, f64::max)
+/// The worst centre error of a case, printed so that `cargo test --release --test frames_detect
+/// -- --nocapture` reproduces the README's table of measured errors.
+fn worst(case: &str, e: &[f64]) -> f64 {
+    let w = e.iter().copied().fold(0.0, f64::max);
+    eprintln!("frames_detect: {case}: worst centre error {w:.3} px");
+    w
 }
 
 #[test]
@@ -49,7 +53,7 @@ fn equal_lamps_no_noise() {
     sc.lamps = [0.45, 0.45];
     let (e, det) = centre_errors(&sc, &DetectSettings::default());
     // Measured 0.069 px (the background gradient makes top and bottom limbs differ).
-    assert!(worst(&e) < 0.1, "{e:?}");
+    assert!(worst("equal_lamps_no_noise", &e) < 0.1, "{e:?}");
     assert_eq!(det.polarity, 1.0);
     // Radii: 0.19-0.24 px short (the limb shading); bar 0.5 px.
     for sp in &det.spheres {
@@ -63,7 +67,10 @@ fn unequal_lamps_noise_and_uneven_background() {
     let sc = Scene::paper_like(192, 239, two());
     let (e, _) = centre_errors(&sc, &DetectSettings::default());
     // Measured 0.071 px.
-    assert!(worst(&e) < 0.15, "{e:?}");
+    assert!(
+        worst("unequal_lamps_noise_and_uneven_background", &e) < 0.15,
+        "{e:?}"
+    );
 }
 
 #[test]
@@ -100,7 +107,10 @@ fn a_limb_as_dark_as_the_background_uses_the_known_radius() {
     // Measured 0.37 px: the visible arcs' edges sit ~0.2 px inside and the radius is held at
     // the true 40 px, so the circle shifts towards the dark side. Bar 0.8 px (twice that);
     // `track` holds the collision's own median radius instead, which carries the same bias.
-    assert!(worst(&e) < 0.8, "{e:?}");
+    assert!(
+        worst("a_limb_as_dark_as_the_background_uses_the_known_radius", &e) < 0.8,
+        "{e:?}"
+    );
     for sp in &det.spheres {
         assert!(sp.coverage_deg < 240.0, "{}", sp.coverage_deg);
         assert_eq!(sp.radius_mode.name(), "fixed_radius");
@@ -122,7 +132,13 @@ fn touching_and_nearly_touching_spheres() {
         let (e, det) = centre_errors(&sc, &DetectSettings::default());
         // Merged into one blob, split at the neck. Measured 0.14 px.
         assert_eq!(det.spheres.len(), 2);
-        assert!(worst(&e) < 0.3, "gap {gap}: {e:?}");
+        assert!(
+            worst(
+                &format!("touching_and_nearly_touching_spheres: gap {}", gap),
+                &e
+            ) < 0.3,
+            "gap {gap}: {e:?}"
+        );
     }
 }
 
@@ -139,7 +155,10 @@ fn dark_spheres_on_a_bright_background() {
     let (e, det) = centre_errors(&sc, &DetectSettings::default());
     assert_eq!(det.polarity, -1.0);
     // The limb now has full contrast everywhere: measured 0.010 px.
-    assert!(worst(&e) < 0.05, "{e:?}");
+    assert!(
+        worst("dark_spheres_on_a_bright_background", &e) < 0.05,
+        "{e:?}"
+    );
 }
 
 #[test]
@@ -158,7 +177,10 @@ fn a_sphere_partly_outside_the_image() {
         );
         let (e, det) = centre_errors(&sc, &s);
         // Measured 0.32 and 0.16 px (arc fits with the radius held).
-        assert!(worst(&e) < bar, "x = {x}: {e:?}");
+        assert!(
+            worst("a_sphere_partly_outside_the_image", &e) < bar,
+            "x = {x}: {e:?}"
+        );
         let cut = det
             .spheres
             .iter()
@@ -176,7 +198,10 @@ fn motion_blur_small_and_unequal_spheres() {
     sc.blur_steps = 7;
     let (e, _) = centre_errors(&sc, &DetectSettings::default());
     // 3 px of motion during the exposure: measured 0.13 px.
-    assert!(worst(&e) < 0.3, "blur: {e:?}");
+    assert!(
+        worst("motion_blur_small_and_unequal_spheres: blur", &e) < 0.3,
+        "blur: {e:?}"
+    );
     let sc = Scene::paper_like(
         192,
         239,
@@ -184,7 +209,10 @@ fn motion_blur_small_and_unequal_spheres() {
     );
     let (e, _) = centre_errors(&sc, &DetectSettings::default());
     // Radius 12.7 px (6.35 mm spheres on the paper's camera): measured 0.091 px.
-    assert!(worst(&e) < 0.25, "small: {e:?}");
+    assert!(
+        worst("motion_blur_small_and_unequal_spheres: small", &e) < 0.25,
+        "small: {e:?}"
+    );
     let sc = Scene::paper_like(
         192,
         239,
@@ -192,7 +220,10 @@ fn motion_blur_small_and_unequal_spheres() {
     );
     let (e, _) = centre_errors(&sc, &DetectSettings::default());
     // Radii 50 and 12.5 px (the paper's 25.4 and 6.35 mm): measured 0.12 px.
-    assert!(worst(&e) < 0.25, "unequal: {e:?}");
+    assert!(
+        worst("motion_blur_small_and_unequal_spheres: unequal", &e) < 0.25,
+        "unequal: {e:?}"
+    );
 }
 
 #[test]
@@ -208,7 +239,7 @@ fn a_megapixel_frame() {
     sc.supersample = 3;
     let (e, _) = centre_errors(&sc, &DetectSettings::default());
     // Large discs average many edge points: measured 0.012 px.
-    assert!(worst(&e) < 0.05, "{e:?}");
+    assert!(worst("a_megapixel_frame", &e) < 0.05, "{e:?}");
 }
 
 #[test]
