@@ -196,7 +196,8 @@ pub fn mutate(sheet: &mut Sheet, rng: &mut StdRng, big_rows: bool) -> Vec<String
                 sheet.rows.truncate(1);
                 "one row".into()
             }
-            62..=64 if big_rows => {
+            // (An earlier mutation may have left no rows to repeat.)
+            62..=64 if big_rows && nrow > 0 => {
                 let base = sheet.rows.clone();
                 sheet.rows = (0..100_000).map(|i| base[i % base.len()].clone()).collect();
                 "100 000 rows".into()
