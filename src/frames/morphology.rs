@@ -4,40 +4,48 @@
 /// Sets background pixels not connected (4-neighbours) to the image border to foreground:
 /// markers inside a disc become part of it.
 pub(crate) fn fill_holes(mask: &mut [bool], w: usize, h: usize) {
-    let mut outside = vec![false; w * h];
-    let mut stack: Vec<usize> = (0..w * h)
-        .filter(|&i| {
-            let (r, c) = (i / w, i % w);
-            (r == 0 || c == 0 || r + 1 == h || c + 1 == w) && !mask[i]
-        })
-        .collect();
-    for &i in &stack {
-        outside[i] = true;
+    if w == 0 || h == 0 {
+        return;
+    }
+    // A frame of one blocked pixel around the image spares the border tests; `open` marks
+    // background pixels not yet reached from the border.
+    let pw = w + 2;
+    let mut open = vec![false; pw * (h + 2)];
+    for r in 0..h {
+        for c in 0..w {
+            open[(r + 1) * pw + c + 1] = !mask[r * w + c];
+        }
+    }
+    let mut stack: Vec<usize> = Vec::new();
+    let mut start = |r: usize, c: usize, open: &mut [bool]| {
+        let i = (r + 1) * pw + c + 1;
+        if open[i] {
+            open[i] = false;
+            stack.push(i);
+        }
+    };
+    for c in 0..w {
+        start(0, c, &mut open);
+        start(h - 1, c, &mut open);
+    }
+    for r in 0..h {
+        start(r, 0, &mut open);
+        start(r, w - 1, &mut open);
     }
     while let Some(i) = stack.pop() {
-        let (r, c) = (i / w, i % w);
-        let mut push = |j: usize| {
-            if !mask[j] && !outside[j] {
-                outside[j] = true;
+        for j in [i - 1, i + 1, i - pw, i + pw] {
+            if open[j] {
+                open[j] = false;
                 stack.push(j);
             }
-        };
-        if c > 0 {
-            push(i - 1);
-        }
-        if c + 1 < w {
-            push(i + 1);
-        }
-        if r > 0 {
-            push(i - w);
-        }
-        if r + 1 < h {
-            push(i + w);
         }
     }
-    for i in 0..w * h {
-        if !mask[i] && !outside[i] {
-            mask[i] = true;
+    // Background pixels never reached are holes.
+    for r in 0..h {
+        for c in 0..w {
+            if open[(r + 1) * pw + c + 1] {
+                mask[r * w + c] = true;
+            }
         }
     }
 }
@@ -84,26 +92,49 @@ pub(crate) fn label(mask: &[bool], w: usize, h: usize) -> (Vec<u32>, Vec<usize>)
 pub(crate) fn edt(fg: &[bool], w: usize, h: usize) -> Vec<f32> {
     const BIG: f64 = 1e12;
     let mut g = vec![0.0f64; w * h];
-    for i in 0..w * h {
-        g[i] = if fg[i] { BIG } else { 0.0 };
-    }
     let mut f = vec![0.0f64; w.max(h)];
     let mut d = vec![0.0f64; w.max(h)];
     let mut v = vec![0usize; w.max(h)];
     let mut z = vec![0.0f64; w.max(h) + 1];
+    // Columns: on a binary image the 1-D transform is the squared distance to the nearest
+    // background pixel of the column (BIG if it has none), found by two scans; the lower
+    // envelope gives the same values (integers and BIG are exact in f64).
+    let mut near = vec![usize::MAX; h];
     for c in 0..w {
-        for r in 0..h {
-            f[r] = g[r * w + c];
+        let mut last = usize::MAX;
+        for (r, nr) in near.iter_mut().enumerate() {
+            if !fg[r * w + c] {
+                last = r;
+            }
+            *nr = if last == usize::MAX {
+                usize::MAX
+            } else {
+                r - last
+            };
         }
-        dt1(&f[..h], &mut d[..h], &mut v, &mut z);
-        for r in 0..h {
-            g[r * w + c] = d[r];
+        let mut last = usize::MAX;
+        for r in (0..h).rev() {
+            if !fg[r * w + c] {
+                last = r;
+            }
+            let below = if last == usize::MAX {
+                usize::MAX
+            } else {
+                last - r
+            };
+            let k = near[r].min(below);
+            g[r * w + c] = if k == usize::MAX { BIG } else { (k * k) as f64 };
         }
     }
     for r in 0..h {
-        f[..w].copy_from_slice(&g[r * w..(r + 1) * w]);
+        let row = &mut g[r * w..(r + 1) * w];
+        // A row of background pixels stays 0.
+        if row.iter().all(|&x| x == 0.0) {
+            continue;
+        }
+        f[..w].copy_from_slice(row);
         dt1(&f[..w], &mut d[..w], &mut v, &mut z);
-        g[r * w..(r + 1) * w].copy_from_slice(&d[..w]);
+        row.copy_from_slice(&d[..w]);
     }
     g.iter().map(|&v| v.sqrt() as f32).collect()
 }
