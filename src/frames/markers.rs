@@ -111,8 +111,13 @@ fn find_markers_at(img: &GrayImage, disc: &Circle, noise: f64, contrast: f64) ->
     let pix = |c: usize, rr: usize| img.get(c0 as usize + c, r0 as usize + rr) as f64;
     // Darkness against the local mean of the disc pixels in `use_px`, by integral images.
     // Disc membership of each pixel of the box, computed once for both passes.
-    let member =
-        |frac: f64| -> Vec<bool> { (0..bw * bh).map(|i| inside(i % bw, i / bw, frac)).collect() };
+    let member = |frac: f64| -> Vec<bool> {
+        let mut m = Vec::with_capacity(bw * bh);
+        for rr in 0..bh {
+            m.extend((0..bw).map(|c| inside(c, rr, frac)));
+        }
+        m
+    };
     let (in95, in_search) = (member(0.95), member(SEARCH_FRACTION));
     let darkness = |use_px: &[bool]| -> (Vec<f64>, Vec<f64>) {
         let stride = bw + 1;

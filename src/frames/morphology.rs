@@ -90,6 +90,40 @@ pub(crate) fn label(mask: &[bool], w: usize, h: usize) -> (Vec<u32>, Vec<usize>)
 /// Felzenszwalb & Huttenlocher's lower-envelope transform (Theory of Computing 8, 415, 2012),
 /// columns then rows.
 pub(crate) fn edt(fg: &[bool], w: usize, h: usize) -> Vec<f32> {
+    // Only the bounding box of the foreground grown by one pixel (clipped to the image) needs
+    // the transform: outside it every pixel is background (0), and a foreground pixel's nearest
+    // background pixel beyond the box has a nearer one on the grown rim (clamp it to the box),
+    // which is background.
+    let (mut r_lo, mut r_hi, mut c_lo, mut c_hi) = (usize::MAX, 0, usize::MAX, 0);
+    for r in 0..h {
+        let row = &fg[r * w..(r + 1) * w];
+        if let Some(first) = row.iter().position(|&x| x) {
+            let last = row.iter().rposition(|&x| x).unwrap_or(first);
+            r_lo = r_lo.min(r);
+            r_hi = r;
+            c_lo = c_lo.min(first);
+            c_hi = c_hi.max(last);
+        }
+    }
+    let mut out = vec![0.0f32; w * h];
+    if r_lo == usize::MAX {
+        return out;
+    }
+    let (r0, r1) = (r_lo.saturating_sub(1), (r_hi + 1).min(h - 1));
+    let (c0, c1) = (c_lo.saturating_sub(1), (c_hi + 1).min(w - 1));
+    let (bw, bh) = (c1 - c0 + 1, r1 - r0 + 1);
+    let sub: Vec<bool> = (r0..=r1)
+        .flat_map(|r| fg[r * w + c0..=r * w + c1].iter().copied())
+        .collect();
+    let d = edt_full(&sub, bw, bh);
+    for r in 0..bh {
+        out[(r0 + r) * w + c0..=(r0 + r) * w + c1].copy_from_slice(&d[r * bw..(r + 1) * bw]);
+    }
+    out
+}
+
+/// `edt` on the whole grid.
+fn edt_full(fg: &[bool], w: usize, h: usize) -> Vec<f32> {
     const BIG: f64 = 1e12;
     let mut g = vec![0.0f64; w * h];
     let mut f = vec![0.0f64; w.max(h)];

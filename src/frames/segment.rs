@@ -403,6 +403,7 @@ pub fn coarse(img: &GrayImage, max_pixels: usize) -> Result<Coarse, CoarseError>
         .collect();
     let dist = edt(&fg, w, h);
     let f = factor as f64;
+    let candidates = distance_maxima(&labels, &dist, w, h);
     let mut seeds = Vec::new();
     let mut n_blobs = 0;
     for (b, &k) in keep.iter().enumerate() {
@@ -411,7 +412,7 @@ pub fn coarse(img: &GrayImage, max_pixels: usize) -> Result<Coarse, CoarseError>
         }
         n_blobs += 1;
         let lab = b as u32 + 1;
-        for (centre, value) in blob_seeds(&labels, lab, &dist, w, h) {
+        for (centre, value) in blob_seeds(&candidates, lab, &dist, w) {
             seeds.push((b, [centre[0] * f, centre[1] * f], value * f));
         }
     }
@@ -498,16 +499,14 @@ pub fn coarse(img: &GrayImage, max_pixels: usize) -> Result<Coarse, CoarseError>
     })
 }
 
-/// Sphere centres in one blob: maxima of the distance transform, greedily from the largest; a
-/// further maximum counts as another sphere only if the transform dips below 60% of the smaller
-/// value on the straight line between them (a neck), so a ridge or plateau gives one seed.
-/// Returns centres (pixel centres of the coarse grid) and transform values in coarse pixels.
-fn blob_seeds(labels: &[u32], lab: u32, dist: &[f32], w: usize, h: usize) -> Vec<([f64; 2], f64)> {
-    let mut maxima: Vec<(usize, f32)> = Vec::new();
+/// Local maxima (8-neighbours) of the distance transform at least 1.5 coarse pixels deep, in
+/// raster order, with their blob labels: the candidates for `blob_seeds`, found in one scan.
+fn distance_maxima(labels: &[u32], dist: &[f32], w: usize, h: usize) -> Vec<(u32, usize, f32)> {
+    let mut maxima = Vec::new();
     for r in 0..h {
         for c in 0..w {
             let i = r * w + c;
-            if labels[i] != lab || dist[i] < 1.5 {
+            if labels[i] == 0 || dist[i] < 1.5 {
                 continue;
             }
             let v = dist[i];
@@ -525,10 +524,28 @@ fn blob_seeds(labels: &[u32], lab: u32, dist: &[f32], w: usize, h: usize) -> Vec
                 }
             }
             if is_max {
-                maxima.push((i, v));
+                maxima.push((labels[i], i, v));
             }
         }
     }
+    maxima
+}
+
+/// Sphere centres in one blob: maxima of the distance transform, greedily from the largest; a
+/// further maximum counts as another sphere only if the transform dips below 60% of the smaller
+/// value on the straight line between them (a neck), so a ridge or plateau gives one seed.
+/// Returns centres (pixel centres of the coarse grid) and transform values in coarse pixels.
+fn blob_seeds(
+    candidates: &[(u32, usize, f32)],
+    lab: u32,
+    dist: &[f32],
+    w: usize,
+) -> Vec<([f64; 2], f64)> {
+    let mut maxima: Vec<(usize, f32)> = candidates
+        .iter()
+        .filter(|m| m.0 == lab)
+        .map(|m| (m.1, m.2))
+        .collect();
     maxima.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
     let mut accepted: Vec<(usize, f32)> = Vec::new();
     for &(i, v) in &maxima {
