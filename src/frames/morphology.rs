@@ -4,6 +4,48 @@
 /// Sets background pixels not connected (4-neighbours) to the image border to foreground:
 /// markers inside a disc become part of it.
 pub(crate) fn fill_holes(mask: &mut [bool], w: usize, h: usize) {
+    // Background outside the foreground's box reaches the border in a straight line, and a
+    // path from inside the grown box to the border crosses the box's edge: the grown box, with
+    // its edge standing for the image border, has the same holes.
+    let Some((r0, r1, c0, c1)) = grown_box(mask, w, h) else {
+        return;
+    };
+    let (bw, bh) = (c1 - c0 + 1, r1 - r0 + 1);
+    let mut sub: Vec<bool> = (r0..=r1)
+        .flat_map(|r| mask[r * w + c0..=r * w + c1].iter().copied())
+        .collect();
+    fill_holes_full(&mut sub, bw, bh);
+    for r in 0..bh {
+        mask[(r0 + r) * w + c0..=(r0 + r) * w + c1].copy_from_slice(&sub[r * bw..(r + 1) * bw]);
+    }
+}
+
+/// The bounding box (first row, last row, first column, last column) of the true pixels of
+/// `mask`, grown by one pixel and clipped to the image; `None` if there are none.
+fn grown_box(mask: &[bool], w: usize, h: usize) -> Option<(usize, usize, usize, usize)> {
+    let (mut r_lo, mut r_hi, mut c_lo, mut c_hi) = (usize::MAX, 0, usize::MAX, 0);
+    for r in 0..h {
+        let row = &mask[r * w..(r + 1) * w];
+        if let Some(first) = row.iter().position(|&x| x) {
+            let last = row.iter().rposition(|&x| x).unwrap_or(first);
+            r_lo = r_lo.min(r);
+            r_hi = r;
+            c_lo = c_lo.min(first);
+            c_hi = c_hi.max(last);
+        }
+    }
+    (r_lo != usize::MAX).then(|| {
+        (
+            r_lo.saturating_sub(1),
+            (r_hi + 1).min(h - 1),
+            c_lo.saturating_sub(1),
+            (c_hi + 1).min(w - 1),
+        )
+    })
+}
+
+/// `fill_holes` on the whole grid.
+fn fill_holes_full(mask: &mut [bool], w: usize, h: usize) {
     if w == 0 || h == 0 {
         return;
     }
@@ -94,23 +136,10 @@ pub(crate) fn edt(fg: &[bool], w: usize, h: usize) -> Vec<f32> {
     // the transform: outside it every pixel is background (0), and a foreground pixel's nearest
     // background pixel beyond the box has a nearer one on the grown rim (clamp it to the box),
     // which is background.
-    let (mut r_lo, mut r_hi, mut c_lo, mut c_hi) = (usize::MAX, 0, usize::MAX, 0);
-    for r in 0..h {
-        let row = &fg[r * w..(r + 1) * w];
-        if let Some(first) = row.iter().position(|&x| x) {
-            let last = row.iter().rposition(|&x| x).unwrap_or(first);
-            r_lo = r_lo.min(r);
-            r_hi = r;
-            c_lo = c_lo.min(first);
-            c_hi = c_hi.max(last);
-        }
-    }
     let mut out = vec![0.0f32; w * h];
-    if r_lo == usize::MAX {
+    let Some((r0, r1, c0, c1)) = grown_box(fg, w, h) else {
         return out;
-    }
-    let (r0, r1) = (r_lo.saturating_sub(1), (r_hi + 1).min(h - 1));
-    let (c0, c1) = (c_lo.saturating_sub(1), (c_hi + 1).min(w - 1));
+    };
     let (bw, bh) = (c1 - c0 + 1, r1 - r0 + 1);
     let sub: Vec<bool> = (r0..=r1)
         .flat_map(|r| fg[r * w + c0..=r * w + c1].iter().copied())
@@ -230,6 +259,33 @@ mod tests {
                 "pixel {i}: {di} vs {brute}"
             );
         }
+    }
+
+    // The boxed fill against the whole-grid flood fill on shapes whose holes and openings sit
+    // at the box's edge: a ring with a one-pixel hole, a C open towards the border, a ring cut
+    // by the image edge (its inside is then outside), and a blob in a corner.
+    #[test]
+    fn boxed_fill_matches_whole_grid() {
+        let (w, h) = (20, 14);
+        let shapes: [&dyn Fn(usize, usize) -> bool; 4] = [
+            &|r, c| (3..=5).contains(&r) && (4..=6).contains(&c) && !(r == 4 && c == 5),
+            &|r, c| (2..=9).contains(&r) && (8..=15).contains(&c) && !(r > 3 && r < 8 && c > 9),
+            &|r, c| {
+                let d = (r as f64 - 1.0).hypot(c as f64 - 10.0);
+                (2.5..4.0).contains(&d)
+            },
+            &|r, c| r + c < 4 || (r > 10 && c > 16 && !(r == 12 && c == 18)),
+        ];
+        for (k, f) in shapes.iter().enumerate() {
+            let m: Vec<bool> = (0..w * h).map(|i| f(i / w, i % w)).collect();
+            let (mut a, mut b) = (m.clone(), m.clone());
+            fill_holes(&mut a, w, h);
+            fill_holes_full(&mut b, w, h);
+            assert_eq!(a, b, "shape {k}");
+        }
+        let mut ring: Vec<bool> = (0..w * h).map(|i| shapes[0](i / w, i % w)).collect();
+        fill_holes(&mut ring, w, h);
+        assert!(ring[4 * w + 5], "the ring's hole is filled");
     }
 
     #[test]

@@ -266,22 +266,27 @@ fn quantiles(v: &[f32], q_lo: f64, q_hi: f64) -> (f32, f32) {
         return (lo, hi);
     }
     // `small` holds the m_lo smallest values so far, ascending; `large` the m_hi largest,
-    // descending.
-    let mut small: Vec<f32> = Vec::with_capacity(m_lo + 1);
-    let mut large: Vec<f32> = Vec::with_capacity(m_hi + 1);
+    // descending. Values are compared by integer keys in the order of `total_cmp`.
+    let key = |x: f32| {
+        let b = x.to_bits() as i32;
+        b ^ (((b >> 31) as u32) >> 1) as i32
+    };
+    let mut small: Vec<(i32, f32)> = Vec::with_capacity(m_lo + 1);
+    let mut large: Vec<(i32, f32)> = Vec::with_capacity(m_hi + 1);
     for &x in v {
-        if small.len() < m_lo || x.total_cmp(&small[m_lo - 1]).is_lt() {
-            let at = small.partition_point(|y| y.total_cmp(&x).is_le());
-            small.insert(at, x);
+        let kx = key(x);
+        if small.len() < m_lo || kx < small[m_lo - 1].0 {
+            let at = small.partition_point(|y| y.0 <= kx);
+            small.insert(at, (kx, x));
             small.truncate(m_lo);
         }
-        if large.len() < m_hi || x.total_cmp(&large[m_hi - 1]).is_gt() {
-            let at = large.partition_point(|y| y.total_cmp(&x).is_ge());
-            large.insert(at, x);
+        if large.len() < m_hi || kx > large[m_hi - 1].0 {
+            let at = large.partition_point(|y| y.0 >= kx);
+            large.insert(at, (kx, x));
             large.truncate(m_hi);
         }
     }
-    (small[m_lo - 1], large[m_hi - 1])
+    (small[m_lo - 1].1, large[m_hi - 1].1)
 }
 
 /// `resid` = `img` minus the quadratic surface `a` (as `fit_background` scales X and Y).
@@ -577,6 +582,29 @@ fn blob_seeds(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    // Both branches (tail buffers, and selection for tails over 4 096 values) against the
+    // nearest ranks of a sorted copy, on values with ties, signs and a -0.0.
+    #[test]
+    fn quantiles_match_sorted_ranks() {
+        let mut state = 7u64;
+        let mut v: Vec<f32> = (0..20_000)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((state >> 40) % 2001) as f32 / 100.0 - 10.0
+            })
+            .collect();
+        v[17] = -0.0;
+        let mut sorted = v.clone();
+        sorted.sort_by(|a, b| a.total_cmp(b));
+        for (lo, hi) in [(0.005, 0.995), (0.0, 1.0), (0.3, 0.7)] {
+            let (a, b) = quantiles(&v, lo, hi);
+            let rank = |q: f64| sorted[((v.len() - 1) as f64 * q) as usize];
+            assert_eq!((a, b), (rank(lo), rank(hi)), "{lo} {hi}");
+        }
+    }
 
     #[test]
     fn otsu_splits_two_levels() {
