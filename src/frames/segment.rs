@@ -94,15 +94,18 @@ fn coarse_image(img: &GrayImage, factor: usize) -> GrayImage {
     let (w, h) = (img.width / factor, img.height / factor);
     let mut out = GrayImage::filled(w, h, 0.0);
     let inv = 1.0 / (factor * factor) as f32;
+    // Row by row of the image: each block's sum gains its rows' partial sums in order.
+    let mut acc = vec![0.0f32; w];
     for r in 0..h {
-        for c in 0..w {
-            let mut s = 0.0f32;
-            for rr in r * factor..(r + 1) * factor {
-                let row =
-                    &img.pixels[rr * img.width + c * factor..rr * img.width + (c + 1) * factor];
-                s += row.iter().sum::<f32>();
+        acc.fill(0.0);
+        for rr in r * factor..(r + 1) * factor {
+            let row = &img.pixels[rr * img.width..rr * img.width + w * factor];
+            for (a, block) in acc.iter_mut().zip(row.chunks_exact(factor)) {
+                *a += block.iter().sum::<f32>();
             }
-            out.pixels[r * w + c] = s * inv;
+        }
+        for (o, a) in out.pixels[r * w..(r + 1) * w].iter_mut().zip(&acc) {
+            *o = a * inv;
         }
     }
     let mut tmp = out.clone();
