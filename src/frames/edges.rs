@@ -40,6 +40,20 @@ pub fn bilinear(img: &GrayImage, u: f64, v: f64) -> Option<f64> {
     Some(top * (1.0 - ty) + bot * ty)
 }
 
+/// `bilinear` at a point known to be inside (u, v >= 0.5, u < width - 0.5, v < height - 0.5):
+/// the same arithmetic without the border tests.
+#[inline(always)]
+fn bilinear_inside(px: &[f32], w: usize, u: f64, v: f64) -> f64 {
+    let (fx, fy) = (u - 0.5, v - 0.5);
+    // fx, fy >= 0 here, so truncation is the floor `bilinear` takes.
+    let (x0, y0) = (fx as u32 as usize, fy as u32 as usize);
+    let (tx, ty) = (fx - x0 as f64, fy - y0 as f64);
+    let i = y0 * w + x0;
+    let top = px[i] as f64 * (1.0 - tx) + px[i + 1] as f64 * tx;
+    let bot = px[i + w] as f64 * (1.0 - tx) + px[i + w + 1] as f64 * tx;
+    top * (1.0 - ty) + bot * ty
+}
+
 /// Subpixel position of a sampled peak: given samples `g[k-1], g[k], g[k+1]` with `g[k]` the
 /// largest, the offset of the maximum from k in samples, in [-0.5, 0.5]. Gaussian interpolation
 /// (a parabola through the logarithms; exact for a Gaussian peak, which a blurred edge's
@@ -166,7 +180,37 @@ pub fn ray_edge(
     // The usable part of the ray: the longest run of in-image samples. Rays begin at the centre
     // side, so a run broken by the image border is cut there.
     let mut first_valid: Option<usize> = None;
-    for i in 0..n {
+    // Most rays lie wholly inside the image: then the three parallel rays are sampled without
+    // the per-sample border tests (the same arithmetic as `bilinear`, so the same values). The
+    // sample positions are linear in i, so the end points of the three rays bound them all;
+    // the margin of 1e-6 px covers rounding in r_lo + i step.
+    let inside = |u: f64, v: f64| {
+        u >= 0.5 + 1e-6
+            && v >= 0.5 + 1e-6
+            && u < img.width as f64 - 0.5 - 1e-6
+            && v < img.height as f64 - 0.5 - 1e-6
+    };
+    let r_end = r_lo + (n - 1) as f64 * s.step;
+    let all_inside = [r_lo, r_end].iter().all(|&r| {
+        let (u, v) = (centre[0] + r * dc, centre[1] + r * ds);
+        [0.0, s.spread, -s.spread]
+            .iter()
+            .all(|&o| inside(u + o * tc, v + o * ts))
+    });
+    if all_inside {
+        let (w, px) = (img.width, &img.pixels[..]);
+        let sample = |u: f64, v: f64| bilinear_inside(px, w, u, v);
+        first_valid = Some(0);
+        for i in 0..n {
+            let r = r_lo + i as f64 * s.step;
+            let (u, v) = (centre[0] + r * dc, centre[1] + r * ds);
+            let a = sample(u, v);
+            let b = sample(u + s.spread * tc, v + s.spread * ts);
+            let c = sample(u - s.spread * tc, v - s.spread * ts);
+            buf.push((a + b + c) / 3.0);
+        }
+    }
+    for i in (0..n).filter(|_| !all_inside) {
         let r = r_lo + i as f64 * s.step;
         let (u, v) = (centre[0] + r * dc, centre[1] + r * ds);
         let a = bilinear(img, u, v);
@@ -195,9 +239,9 @@ pub fn ray_edge(
     let mut best = (usize::MAX, f64::NEG_INFINITY);
     let g = |i: usize| -> f64 {
         let mut acc = 0.0;
-        for (j, kj) in kernel.iter().enumerate() {
-            // f(s - (j - half) step)
-            acc += kj * buf[i + half - j];
+        // kernel[j] meets f(s - (j - half) step) = buf[i + half - j].
+        for (kj, bj) in kernel.iter().zip(buf[i - half..=i + half].iter().rev()) {
+            acc += kj * bj;
         }
         polarity * acc
     };

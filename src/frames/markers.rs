@@ -110,14 +110,23 @@ fn find_markers_at(img: &GrayImage, disc: &Circle, noise: f64, contrast: f64) ->
     let thr = (5.0 * noise).max(0.1 * contrast);
     let pix = |c: usize, rr: usize| img.get(c0 as usize + c, r0 as usize + rr) as f64;
     // Darkness against the local mean of the disc pixels in `use_px`, by integral images.
-    let darkness = |use_px: &dyn Fn(usize, usize) -> bool| -> (Vec<f64>, Vec<f64>) {
+    // Disc membership of each pixel of the box, computed once for both passes.
+    let member = |frac: f64| -> Vec<bool> {
+        let mut m = Vec::with_capacity(bw * bh);
+        for rr in 0..bh {
+            m.extend((0..bw).map(|c| inside(c, rr, frac)));
+        }
+        m
+    };
+    let (in95, in_search) = (member(0.95), member(SEARCH_FRACTION));
+    let darkness = |use_px: &[bool]| -> (Vec<f64>, Vec<f64>) {
         let stride = bw + 1;
         let mut si = vec![0.0f64; stride * (bh + 1)];
         let mut sm = vec![0.0f64; stride * (bh + 1)];
         for rr in 0..bh {
             let (mut ri, mut rm) = (0.0, 0.0);
             for c in 0..bw {
-                if use_px(c, rr) {
+                if use_px[rr * bw + c] {
                     ri += pix(c, rr);
                     rm += 1.0;
                 }
@@ -134,7 +143,7 @@ fn find_markers_at(img: &GrayImage, disc: &Circle, noise: f64, contrast: f64) ->
         let mut level = vec![0.0f64; bw * bh];
         for rr in 0..bh {
             for c in 0..bw {
-                if !inside(c, rr, SEARCH_FRACTION) {
+                if !in_search[rr * bw + c] {
                     continue;
                 }
                 let n = box_sum(&sm, c, rr);
@@ -150,7 +159,7 @@ fn find_markers_at(img: &GrayImage, disc: &Circle, noise: f64, contrast: f64) ->
     // Pass 1 finds the dots against a mean that they darken themselves; pass 2 takes the mean
     // without them (and their one-pixel rim), so the weights of partly covered rim pixels are
     // their true darkness and the centroid is not pulled.
-    let (first, _) = darkness(&|c, rr| inside(c, rr, 0.95));
+    let (first, _) = darkness(&in95);
     let mut dotted = vec![false; bw * bh];
     for i in (0..bw * bh).filter(|&i| first[i] > thr) {
         dotted[i] = true;
@@ -158,7 +167,8 @@ fn find_markers_at(img: &GrayImage, disc: &Circle, noise: f64, contrast: f64) ->
             dotted[j] = true;
         }
     }
-    let (dark, level) = darkness(&|c, rr| inside(c, rr, 0.95) && !dotted[rr * bw + c]);
+    let use2: Vec<bool> = in95.iter().zip(&dotted).map(|(&a, &d)| a && !d).collect();
+    let (dark, level) = darkness(&use2);
     // Connected dots (8-neighbours: a small dot drawn at an angle may touch only diagonally).
     let max_area = (0.1 * std::f64::consts::PI * r * r) as usize;
     let above = |i: usize| dark[i] > thr;

@@ -4,40 +4,90 @@
 /// Sets background pixels not connected (4-neighbours) to the image border to foreground:
 /// markers inside a disc become part of it.
 pub(crate) fn fill_holes(mask: &mut [bool], w: usize, h: usize) {
-    let mut outside = vec![false; w * h];
-    let mut stack: Vec<usize> = (0..w * h)
-        .filter(|&i| {
-            let (r, c) = (i / w, i % w);
-            (r == 0 || c == 0 || r + 1 == h || c + 1 == w) && !mask[i]
-        })
+    // Background outside the foreground's box reaches the border in a straight line, and a
+    // path from inside the grown box to the border crosses the box's edge: the grown box, with
+    // its edge standing for the image border, has the same holes.
+    let Some((r0, r1, c0, c1)) = grown_box(mask, w, h) else {
+        return;
+    };
+    let (bw, bh) = (c1 - c0 + 1, r1 - r0 + 1);
+    let mut sub: Vec<bool> = (r0..=r1)
+        .flat_map(|r| mask[r * w + c0..=r * w + c1].iter().copied())
         .collect();
-    for &i in &stack {
-        outside[i] = true;
+    fill_holes_full(&mut sub, bw, bh);
+    for r in 0..bh {
+        mask[(r0 + r) * w + c0..=(r0 + r) * w + c1].copy_from_slice(&sub[r * bw..(r + 1) * bw]);
+    }
+}
+
+/// The bounding box (first row, last row, first column, last column) of the true pixels of
+/// `mask`, grown by one pixel and clipped to the image; `None` if there are none.
+fn grown_box(mask: &[bool], w: usize, h: usize) -> Option<(usize, usize, usize, usize)> {
+    let (mut r_lo, mut r_hi, mut c_lo, mut c_hi) = (usize::MAX, 0, usize::MAX, 0);
+    for r in 0..h {
+        let row = &mask[r * w..(r + 1) * w];
+        if let Some(first) = row.iter().position(|&x| x) {
+            let last = row.iter().rposition(|&x| x).unwrap_or(first);
+            r_lo = r_lo.min(r);
+            r_hi = r;
+            c_lo = c_lo.min(first);
+            c_hi = c_hi.max(last);
+        }
+    }
+    (r_lo != usize::MAX).then(|| {
+        (
+            r_lo.saturating_sub(1),
+            (r_hi + 1).min(h - 1),
+            c_lo.saturating_sub(1),
+            (c_hi + 1).min(w - 1),
+        )
+    })
+}
+
+/// `fill_holes` on the whole grid.
+fn fill_holes_full(mask: &mut [bool], w: usize, h: usize) {
+    if w == 0 || h == 0 {
+        return;
+    }
+    // A frame of one blocked pixel around the image spares the border tests; `open` marks
+    // background pixels not yet reached from the border.
+    let pw = w + 2;
+    let mut open = vec![false; pw * (h + 2)];
+    for r in 0..h {
+        for c in 0..w {
+            open[(r + 1) * pw + c + 1] = !mask[r * w + c];
+        }
+    }
+    let mut stack: Vec<usize> = Vec::new();
+    let mut start = |r: usize, c: usize, open: &mut [bool]| {
+        let i = (r + 1) * pw + c + 1;
+        if open[i] {
+            open[i] = false;
+            stack.push(i);
+        }
+    };
+    for c in 0..w {
+        start(0, c, &mut open);
+        start(h - 1, c, &mut open);
+    }
+    for r in 0..h {
+        start(r, 0, &mut open);
+        start(r, w - 1, &mut open);
     }
     while let Some(i) = stack.pop() {
-        let (r, c) = (i / w, i % w);
-        let mut push = |j: usize| {
-            if !mask[j] && !outside[j] {
-                outside[j] = true;
+        for j in [i - 1, i + 1, i - pw, i + pw] {
+            if open[j] {
+                open[j] = false;
                 stack.push(j);
             }
-        };
-        if c > 0 {
-            push(i - 1);
-        }
-        if c + 1 < w {
-            push(i + 1);
-        }
-        if r > 0 {
-            push(i - w);
-        }
-        if r + 1 < h {
-            push(i + w);
         }
     }
-    for i in 0..w * h {
-        if !mask[i] && !outside[i] {
-            mask[i] = true;
+    // Background pixels never reached are holes.
+    for r in 0..h {
+        for c in 0..w {
+            if open[(r + 1) * pw + c + 1] {
+                mask[r * w + c] = true;
+            }
         }
     }
 }
@@ -82,28 +132,72 @@ pub(crate) fn label(mask: &[bool], w: usize, h: usize) -> (Vec<u32>, Vec<usize>)
 /// Felzenszwalb & Huttenlocher's lower-envelope transform (Theory of Computing 8, 415, 2012),
 /// columns then rows.
 pub(crate) fn edt(fg: &[bool], w: usize, h: usize) -> Vec<f32> {
+    // Only the bounding box of the foreground grown by one pixel (clipped to the image) needs
+    // the transform: outside it every pixel is background (0), and a foreground pixel's nearest
+    // background pixel beyond the box has a nearer one on the grown rim (clamp it to the box),
+    // which is background.
+    let mut out = vec![0.0f32; w * h];
+    let Some((r0, r1, c0, c1)) = grown_box(fg, w, h) else {
+        return out;
+    };
+    let (bw, bh) = (c1 - c0 + 1, r1 - r0 + 1);
+    let sub: Vec<bool> = (r0..=r1)
+        .flat_map(|r| fg[r * w + c0..=r * w + c1].iter().copied())
+        .collect();
+    let d = edt_full(&sub, bw, bh);
+    for r in 0..bh {
+        out[(r0 + r) * w + c0..=(r0 + r) * w + c1].copy_from_slice(&d[r * bw..(r + 1) * bw]);
+    }
+    out
+}
+
+/// `edt` on the whole grid.
+fn edt_full(fg: &[bool], w: usize, h: usize) -> Vec<f32> {
     const BIG: f64 = 1e12;
     let mut g = vec![0.0f64; w * h];
-    for i in 0..w * h {
-        g[i] = if fg[i] { BIG } else { 0.0 };
-    }
     let mut f = vec![0.0f64; w.max(h)];
     let mut d = vec![0.0f64; w.max(h)];
     let mut v = vec![0usize; w.max(h)];
     let mut z = vec![0.0f64; w.max(h) + 1];
+    // Columns: on a binary image the 1-D transform is the squared distance to the nearest
+    // background pixel of the column (BIG if it has none), found by two scans; the lower
+    // envelope gives the same values (integers and BIG are exact in f64).
+    let mut near = vec![usize::MAX; h];
     for c in 0..w {
-        for r in 0..h {
-            f[r] = g[r * w + c];
+        let mut last = usize::MAX;
+        for (r, nr) in near.iter_mut().enumerate() {
+            if !fg[r * w + c] {
+                last = r;
+            }
+            *nr = if last == usize::MAX {
+                usize::MAX
+            } else {
+                r - last
+            };
         }
-        dt1(&f[..h], &mut d[..h], &mut v, &mut z);
-        for r in 0..h {
-            g[r * w + c] = d[r];
+        let mut last = usize::MAX;
+        for r in (0..h).rev() {
+            if !fg[r * w + c] {
+                last = r;
+            }
+            let below = if last == usize::MAX {
+                usize::MAX
+            } else {
+                last - r
+            };
+            let k = near[r].min(below);
+            g[r * w + c] = if k == usize::MAX { BIG } else { (k * k) as f64 };
         }
     }
     for r in 0..h {
-        f[..w].copy_from_slice(&g[r * w..(r + 1) * w]);
+        let row = &mut g[r * w..(r + 1) * w];
+        // A row of background pixels stays 0.
+        if row.iter().all(|&x| x == 0.0) {
+            continue;
+        }
+        f[..w].copy_from_slice(row);
         dt1(&f[..w], &mut d[..w], &mut v, &mut z);
-        g[r * w..(r + 1) * w].copy_from_slice(&d[..w]);
+        row.copy_from_slice(&d[..w]);
     }
     g.iter().map(|&v| v.sqrt() as f32).collect()
 }
@@ -165,6 +259,33 @@ mod tests {
                 "pixel {i}: {di} vs {brute}"
             );
         }
+    }
+
+    // The boxed fill against the whole-grid flood fill on shapes whose holes and openings sit
+    // at the box's edge: a ring with a one-pixel hole, a C open towards the border, a ring cut
+    // by the image edge (its inside is then outside), and a blob in a corner.
+    #[test]
+    fn boxed_fill_matches_whole_grid() {
+        let (w, h) = (20, 14);
+        let shapes: [&dyn Fn(usize, usize) -> bool; 4] = [
+            &|r, c| (3..=5).contains(&r) && (4..=6).contains(&c) && !(r == 4 && c == 5),
+            &|r, c| (2..=9).contains(&r) && (8..=15).contains(&c) && !(r > 3 && r < 8 && c > 9),
+            &|r, c| {
+                let d = (r as f64 - 1.0).hypot(c as f64 - 10.0);
+                (2.5..4.0).contains(&d)
+            },
+            &|r, c| r + c < 4 || (r > 10 && c > 16 && !(r == 12 && c == 18)),
+        ];
+        for (k, f) in shapes.iter().enumerate() {
+            let m: Vec<bool> = (0..w * h).map(|i| f(i / w, i % w)).collect();
+            let (mut a, mut b) = (m.clone(), m.clone());
+            fill_holes(&mut a, w, h);
+            fill_holes_full(&mut b, w, h);
+            assert_eq!(a, b, "shape {k}");
+        }
+        let mut ring: Vec<bool> = (0..w * h).map(|i| shapes[0](i / w, i % w)).collect();
+        fill_holes(&mut ring, w, h);
+        assert!(ring[4 * w + 5], "the ring's hole is filled");
     }
 
     #[test]

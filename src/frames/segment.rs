@@ -94,15 +94,18 @@ fn coarse_image(img: &GrayImage, factor: usize) -> GrayImage {
     let (w, h) = (img.width / factor, img.height / factor);
     let mut out = GrayImage::filled(w, h, 0.0);
     let inv = 1.0 / (factor * factor) as f32;
+    // Row by row of the image: each block's sum gains its rows' partial sums in order.
+    let mut acc = vec![0.0f32; w];
     for r in 0..h {
-        for c in 0..w {
-            let mut s = 0.0f32;
-            for rr in r * factor..(r + 1) * factor {
-                let row =
-                    &img.pixels[rr * img.width + c * factor..rr * img.width + (c + 1) * factor];
-                s += row.iter().sum::<f32>();
+        acc.fill(0.0);
+        for rr in r * factor..(r + 1) * factor {
+            let row = &img.pixels[rr * img.width..rr * img.width + w * factor];
+            for (a, block) in acc.iter_mut().zip(row.chunks_exact(factor)) {
+                *a += block.iter().sum::<f32>();
             }
-            out.pixels[r * w + c] = s * inv;
+        }
+        for (o, a) in out.pixels[r * w..(r + 1) * w].iter_mut().zip(&acc) {
+            *o = a * inv;
         }
     }
     let mut tmp = out.clone();
@@ -174,50 +177,139 @@ fn fit_background(img: &GrayImage, use_px: &[bool]) -> Option<[f64; 6]> {
     let stride = (((w * h) as f64 / 4_000.0).sqrt().floor() as usize).max(1);
     let mut ata = SMatrix::<f64, 6, 6>::zeros();
     let mut atb = SVector::<f64, 6>::zeros();
+    // Sums of b_i b_j (i <= j; numbered row by row: (0,0) 0, (0,5) 5, (1,1) 6, (2,2) 11,
+    // (3,3) 15, (4,4) 18, (5,5) 20) and of b_i v, b = [1, x, y, x^2, x y, y^2]. Every product
+    // is x^a y^b, and y is fixed along a row: each row sums the powers of x (and x^a v) over
+    // its pixels once, then adds them times the powers of y. Same sums, a third of the work.
+    let mut u = [0.0f64; 21];
+    let mut rhs = [0.0f64; 6];
+    let xs: Vec<[f64; 4]> = (0..w)
+        .step_by(stride)
+        .map(|c| {
+            let x = 2.0 * (c as f64 + 0.5) / w as f64 - 1.0;
+            [x, x * x, x * x * x, x * x * x * x]
+        })
+        .collect();
     for r in (0..h).step_by(stride) {
         let y = 2.0 * (r as f64 + 0.5) / h as f64 - 1.0;
-        for c in (0..w).step_by(stride) {
+        let (y2, y3, y4) = (y * y, y * y * y, y * y * y * y);
+        // Row sums of x^0..x^4 and of x^0..x^2 times the pixel value.
+        let mut sx = [0.0f64; 5];
+        let mut sv = [0.0f64; 3];
+        for (c, p) in (0..w).step_by(stride).zip(&xs) {
             if !use_px[r * w + c] {
                 continue;
             }
-            let x = 2.0 * (c as f64 + 0.5) / w as f64 - 1.0;
-            let b = [1.0, x, y, x * x, x * y, y * y];
             let v = img.pixels[r * w + c] as f64;
-            for i in 0..6 {
-                atb[i] += b[i] * v;
-                for j in i..6 {
-                    ata[(i, j)] += b[i] * b[j];
-                }
-            }
+            sx[0] += 1.0;
+            sx[1] += p[0];
+            sx[2] += p[1];
+            sx[3] += p[2];
+            sx[4] += p[3];
+            sv[0] += v;
+            sv[1] += p[0] * v;
+            sv[2] += p[1] * v;
         }
+        if sx[0] == 0.0 {
+            continue;
+        }
+        u[0] += sx[0];
+        u[1] += sx[1];
+        u[2] += y * sx[0];
+        u[3] += sx[2];
+        u[4] += y * sx[1];
+        u[5] += y2 * sx[0];
+        u[8] += sx[3];
+        u[9] += y * sx[2];
+        u[10] += y2 * sx[1];
+        u[14] += y3 * sx[0];
+        u[15] += sx[4];
+        u[16] += y * sx[3];
+        u[17] += y2 * sx[2];
+        u[19] += y3 * sx[1];
+        u[20] += y4 * sx[0];
+        rhs[0] += sv[0];
+        rhs[1] += sv[1];
+        rhs[2] += y * sv[0];
+        rhs[3] += sv[2];
+        rhs[4] += y * sv[1];
+        rhs[5] += y2 * sv[0];
     }
+    // (1,1) = (0,3) = x^2, (1,2) = (0,4) = x y, (2,2) = (0,5) = y^2, (2,3) = (1,4) = x^2 y,
+    // (2,4) = (1,5) = x y^2, (4,4) = (3,5) = x^2 y^2.
+    (u[6], u[7], u[11]) = (u[3], u[4], u[5]);
+    (u[12], u[13], u[18]) = (u[9], u[10], u[17]);
+    let mut k = 0;
     for i in 0..6 {
-        for j in 0..i {
-            ata[(i, j)] = ata[(j, i)];
+        atb[i] = rhs[i];
+        for j in i..6 {
+            ata[(i, j)] = u[k];
+            ata[(j, i)] = u[k];
+            k += 1;
         }
     }
     let sol = ata.cholesky()?.solve(&atb);
     sol.iter().all(|v| v.is_finite()).then(|| sol.into())
 }
 
-/// The q-quantile of `v` (nearest rank), by selection: O(n), reorders `v`.
-fn quantile(v: &mut [f32], q: f64) -> f32 {
-    let k = ((v.len() - 1) as f64 * q) as usize;
-    *v.select_nth_unstable_by(k, |a, b| a.total_cmp(b)).1
-}
-
-fn eval_background(a: &[f64; 6], w: usize, h: usize) -> Vec<f32> {
-    let mut out = Vec::with_capacity(w * h);
-    for r in 0..h {
-        let y = 2.0 * (r as f64 + 0.5) / h as f64 - 1.0;
-        for c in 0..w {
-            let x = 2.0 * (c as f64 + 0.5) / w as f64 - 1.0;
-            out.push(
-                (a[0] + a[1] * x + a[2] * y + a[3] * x * x + a[4] * x * y + a[5] * y * y) as f32,
-            );
+/// The q_lo- and q_hi-quantiles of `v` (nearest rank, q_lo <= q_hi; the ranks
+/// floor((n - 1) q) in the order of `total_cmp`). Tails of up to 4 096 values are kept in sorted
+/// buffers in one pass (few values enter them); longer ones are selected in a copy.
+fn quantiles(v: &[f32], q_lo: f64, q_hi: f64) -> (f32, f32) {
+    let n = v.len();
+    let k_lo = ((n - 1) as f64 * q_lo) as usize;
+    let k_hi = ((n - 1) as f64 * q_hi) as usize;
+    let (m_lo, m_hi) = (k_lo + 1, n - k_hi);
+    if m_lo.max(m_hi) > 4_096 {
+        let mut s = v.to_vec();
+        let hi = *s.select_nth_unstable_by(k_hi, |a, b| a.total_cmp(b)).1;
+        let lo = *s[..=k_hi]
+            .select_nth_unstable_by(k_lo, |a, b| a.total_cmp(b))
+            .1;
+        return (lo, hi);
+    }
+    // `small` holds the m_lo smallest values so far, ascending; `large` the m_hi largest,
+    // descending. Values are compared by integer keys in the order of `total_cmp`.
+    let key = |x: f32| {
+        let b = x.to_bits() as i32;
+        b ^ (((b >> 31) as u32) >> 1) as i32
+    };
+    let mut small: Vec<(i32, f32)> = Vec::with_capacity(m_lo + 1);
+    let mut large: Vec<(i32, f32)> = Vec::with_capacity(m_hi + 1);
+    for &x in v {
+        let kx = key(x);
+        if small.len() < m_lo || kx < small[m_lo - 1].0 {
+            let at = small.partition_point(|y| y.0 <= kx);
+            small.insert(at, (kx, x));
+            small.truncate(m_lo);
+        }
+        if large.len() < m_hi || kx > large[m_hi - 1].0 {
+            let at = large.partition_point(|y| y.0 >= kx);
+            large.insert(at, (kx, x));
+            large.truncate(m_hi);
         }
     }
-    out
+    (small[m_lo - 1].1, large[m_hi - 1].1)
+}
+
+/// `resid` = `img` minus the quadratic surface `a` (as `fit_background` scales X and Y).
+fn eval_residual(a: &[f64; 6], img: &GrayImage, resid: &mut [f32]) {
+    let (w, h) = (img.width, img.height);
+    let xs: Vec<f64> = (0..w)
+        .map(|c| 2.0 * (c as f64 + 0.5) / w as f64 - 1.0)
+        .collect();
+    for r in 0..h {
+        let y = 2.0 * (r as f64 + 0.5) / h as f64 - 1.0;
+        let (src, dst) = (
+            &img.pixels[r * w..(r + 1) * w],
+            &mut resid[r * w..(r + 1) * w],
+        );
+        for ((&x, &p), d) in xs.iter().zip(src).zip(dst) {
+            let bg =
+                (a[0] + a[1] * x + a[2] * y + a[3] * x * x + a[4] * x * y + a[5] * y * y) as f32;
+            *d = p - bg;
+        }
+    }
 }
 
 /// The coarse stage; see the module doc. `max_pixels` bounds the coarse grid (speed).
@@ -242,13 +334,16 @@ pub fn coarse(img: &GrayImage, max_pixels: usize) -> Result<Coarse, CoarseError>
 
     // 1. Otsu split, background = the class holding most of the border.
     let t0 = otsu(&cimg.pixels);
-    let is_border = |i: usize| {
-        let (r, c) = (i / w, i % w);
-        r == 0 || c == 0 || r + 1 == h || c + 1 == w
+    // The border pixels' indices: top and bottom rows, then the columns between them.
+    let border: Vec<usize> = if w >= 2 && h >= 2 {
+        (0..w)
+            .flat_map(|c| [c, (h - 1) * w + c])
+            .chain((1..h - 1).flat_map(|r| [r * w, r * w + w - 1]))
+            .collect()
+    } else {
+        (0..w * h).collect()
     };
-    let border_hi = (0..w * h)
-        .filter(|&i| is_border(i) && cimg.pixels[i] > t0)
-        .count();
+    let border_hi = border.iter().filter(|&&i| cimg.pixels[i] > t0).count();
     let border_n = 2 * (w + h) - 4;
     let bg_hi = 2 * border_hi > border_n;
     let mut bg_mask: Vec<bool> = cimg.pixels.iter().map(|&v| (v > t0) == bg_hi).collect();
@@ -262,23 +357,20 @@ pub fn coarse(img: &GrayImage, max_pixels: usize) -> Result<Coarse, CoarseError>
         let Some(a) = fit_background(&cimg, &bg_mask) else {
             return Err(CoarseError::NoBlob);
         };
-        let bg = eval_background(&a, w, h);
-        for i in 0..w * h {
-            resid[i] = cimg.pixels[i] - bg[i];
-        }
+        eval_residual(&a, &cimg, &mut resid);
         // Polarity: the side with more pixels far from the background. Markers and shaded limbs
         // put some pixels on the other side, but far fewer than the discs.
-        let mut scratch = resid.clone();
-        let hi = quantile(&mut scratch, 0.995);
-        let lo = quantile(&mut scratch, 0.005);
+        let (lo, hi) = quantiles(&resid, 0.005, 0.995);
         let t = 0.25 * hi.max(-lo);
-        let n_pos = resid.iter().filter(|&&v| v > t).count();
-        let n_neg = resid.iter().filter(|&&v| v < -t).count();
+        let (n_pos, n_neg) = resid.iter().fold((0usize, 0usize), |(p, n), &v| {
+            (p + (v > t) as usize, n + (v < -t) as usize)
+        });
         polarity = if n_pos >= n_neg { 1.0 } else { -1.0 };
-        let far: Vec<f32> = resid
+        let mut far: Vec<f64> = resid
             .iter()
             .map(|&v| v * polarity as f32)
             .filter(|&v| v > t)
+            .map(|v| v as f64)
             .collect();
         if far.is_empty() {
             return Err(CoarseError::NoContrast {
@@ -286,7 +378,7 @@ pub fn coarse(img: &GrayImage, max_pixels: usize) -> Result<Coarse, CoarseError>
                 noise,
             });
         }
-        level = median(&mut far.iter().map(|&v| v as f64).collect::<Vec<_>>());
+        level = median(&mut far);
         if round == 0 {
             let half = (0.5 * level) as f32;
             for i in 0..w * h {
@@ -319,6 +411,7 @@ pub fn coarse(img: &GrayImage, max_pixels: usize) -> Result<Coarse, CoarseError>
         .collect();
     let dist = edt(&fg, w, h);
     let f = factor as f64;
+    let candidates = distance_maxima(&labels, &dist, w, h);
     let mut seeds = Vec::new();
     let mut n_blobs = 0;
     for (b, &k) in keep.iter().enumerate() {
@@ -327,7 +420,7 @@ pub fn coarse(img: &GrayImage, max_pixels: usize) -> Result<Coarse, CoarseError>
         }
         n_blobs += 1;
         let lab = b as u32 + 1;
-        for (centre, value) in blob_seeds(&labels, lab, &dist, w, h) {
+        for (centre, value) in blob_seeds(&candidates, lab, &dist, w) {
             seeds.push((b, [centre[0] * f, centre[1] * f], value * f));
         }
     }
@@ -335,7 +428,7 @@ pub fn coarse(img: &GrayImage, max_pixels: usize) -> Result<Coarse, CoarseError>
     let vmax = seeds.iter().map(|s| s.2).fold(0.0, f64::max);
     seeds.retain(|s| s.2 >= 0.2 * vmax);
     let mut touches = vec![false; areas.len()];
-    for i in (0..w * h).filter(|&i| is_border(i) && labels[i] != 0) {
+    for &i in border.iter().filter(|&&i| labels[i] != 0) {
         touches[labels[i] as usize - 1] = true;
     }
     // Boundary points (between a blob pixel and a background pixel inside the image), assigned
@@ -414,16 +507,14 @@ pub fn coarse(img: &GrayImage, max_pixels: usize) -> Result<Coarse, CoarseError>
     })
 }
 
-/// Sphere centres in one blob: maxima of the distance transform, greedily from the largest; a
-/// further maximum counts as another sphere only if the transform dips below 60% of the smaller
-/// value on the straight line between them (a neck), so a ridge or plateau gives one seed.
-/// Returns centres (pixel centres of the coarse grid) and transform values in coarse pixels.
-fn blob_seeds(labels: &[u32], lab: u32, dist: &[f32], w: usize, h: usize) -> Vec<([f64; 2], f64)> {
-    let mut maxima: Vec<(usize, f32)> = Vec::new();
+/// Local maxima (8-neighbours) of the distance transform at least 1.5 coarse pixels deep, in
+/// raster order, with their blob labels: the candidates for `blob_seeds`, found in one scan.
+fn distance_maxima(labels: &[u32], dist: &[f32], w: usize, h: usize) -> Vec<(u32, usize, f32)> {
+    let mut maxima = Vec::new();
     for r in 0..h {
         for c in 0..w {
             let i = r * w + c;
-            if labels[i] != lab || dist[i] < 1.5 {
+            if labels[i] == 0 || dist[i] < 1.5 {
                 continue;
             }
             let v = dist[i];
@@ -441,10 +532,28 @@ fn blob_seeds(labels: &[u32], lab: u32, dist: &[f32], w: usize, h: usize) -> Vec
                 }
             }
             if is_max {
-                maxima.push((i, v));
+                maxima.push((labels[i], i, v));
             }
         }
     }
+    maxima
+}
+
+/// Sphere centres in one blob: maxima of the distance transform, greedily from the largest; a
+/// further maximum counts as another sphere only if the transform dips below 60% of the smaller
+/// value on the straight line between them (a neck), so a ridge or plateau gives one seed.
+/// Returns centres (pixel centres of the coarse grid) and transform values in coarse pixels.
+fn blob_seeds(
+    candidates: &[(u32, usize, f32)],
+    lab: u32,
+    dist: &[f32],
+    w: usize,
+) -> Vec<([f64; 2], f64)> {
+    let mut maxima: Vec<(usize, f32)> = candidates
+        .iter()
+        .filter(|m| m.0 == lab)
+        .map(|m| (m.1, m.2))
+        .collect();
     maxima.sort_by(|a, b| b.1.total_cmp(&a.1).then(a.0.cmp(&b.0)));
     let mut accepted: Vec<(usize, f32)> = Vec::new();
     for &(i, v) in &maxima {
@@ -476,6 +585,29 @@ fn blob_seeds(labels: &[u32], lab: u32, dist: &[f32], w: usize, h: usize) -> Vec
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    // Both branches (tail buffers, and selection for tails over 4 096 values) against the
+    // nearest ranks of a sorted copy, on values with ties, signs and a -0.0.
+    #[test]
+    fn quantiles_match_sorted_ranks() {
+        let mut state = 7u64;
+        let mut v: Vec<f32> = (0..20_000)
+            .map(|_| {
+                state = state
+                    .wrapping_mul(6364136223846793005)
+                    .wrapping_add(1442695040888963407);
+                ((state >> 40) % 2001) as f32 / 100.0 - 10.0
+            })
+            .collect();
+        v[17] = -0.0;
+        let mut sorted = v.clone();
+        sorted.sort_by(|a, b| a.total_cmp(b));
+        for (lo, hi) in [(0.005, 0.995), (0.0, 1.0), (0.3, 0.7)] {
+            let (a, b) = quantiles(&v, lo, hi);
+            let rank = |q: f64| sorted[((v.len() - 1) as f64 * q) as usize];
+            assert_eq!((a, b), (rank(lo), rank(hi)), "{lo} {hi}");
+        }
+    }
 
     #[test]
     fn otsu_splits_two_levels() {
