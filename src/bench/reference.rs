@@ -81,7 +81,7 @@ pub fn series_constant(name: &str) -> Option<f64> {
     let (cn, cv) = (t.column("name")?, t.column("value")?);
     t.rows
         .iter()
-        .find(|r| r.fields[cn] == name)
+        .find(|r| &r.fields[cn] == name)
         .and_then(|r| t.number(r, cv).ok())
 }
 

@@ -20,7 +20,8 @@ use std::path::Path;
 #[derive(Debug, Clone)]
 pub struct Row {
     pub line: usize,
-    pub fields: Vec<String>,
+    /// The fields, trimmed: one allocation per row rather than one per field.
+    pub fields: csv::StringRecord,
 }
 
 /// A parsed CSV file: header names (trimmed) and data rows.
@@ -103,18 +104,28 @@ fn field_text(
 ) -> Result<String, DataError> {
     match std::str::from_utf8(raw) {
         Ok(s) => Ok(s.trim().to_string()),
-        Err(e) => {
-            let bad = raw[e.valid_up_to()];
-            Err(DataError {
-                path: path.to_string(),
-                line: Some(line),
-                column: Some(column.map_or_else(|| format!("field {}", j + 1), str::to_string)),
-                message: format!(
-                    "'{}' is not UTF-8 text (byte 0x{bad:02X}): save the file as UTF-8",
-                    shown(String::from_utf8_lossy(raw).trim())
-                ),
-            })
-        }
+        Err(e) => Err(not_utf8(path, line, column, j, raw, e)),
+    }
+}
+
+/// The error for field `j`, whose bytes `raw` are not UTF-8.
+fn not_utf8(
+    path: &str,
+    line: usize,
+    column: Option<&str>,
+    j: usize,
+    raw: &[u8],
+    e: std::str::Utf8Error,
+) -> DataError {
+    let bad = raw[e.valid_up_to()];
+    DataError {
+        path: path.to_string(),
+        line: Some(line),
+        column: Some(column.map_or_else(|| format!("field {}", j + 1), str::to_string)),
+        message: format!(
+            "'{}' is not UTF-8 text (byte 0x{bad:02X}): save the file as UTF-8",
+            shown(String::from_utf8_lossy(raw).trim())
+        ),
     }
 }
 
@@ -209,9 +220,16 @@ impl Table {
                             format!("has {} fields, the header has {}", rec.len(), h.len()),
                         ));
                     }
-                    let fields = (0..rec.len())
-                        .map(|j| field_text(path, line, Some(&h[j]), j, &rec[j]))
-                        .collect::<Result<Vec<_>, _>>()?;
+                    let mut fields =
+                        csv::StringRecord::with_capacity(rec.as_slice().len(), rec.len());
+                    for j in 0..rec.len() {
+                        match std::str::from_utf8(&rec[j]) {
+                            Ok(text) => fields.push_field(text.trim()),
+                            Err(e) => {
+                                return Err(not_utf8(path, line, Some(&h[j]), j, &rec[j], e));
+                            }
+                        }
+                    }
                     rows.push(Row { line, fields });
                 }
             }
@@ -310,8 +328,11 @@ impl Table {
 
     /// A positive number, or +infinity when the cell says `inf` (a flat wall's diameter).
     pub fn positive_or_inf(&self, row: &Row, col: usize) -> Result<f64, DataError> {
-        let raw = row.fields[col].to_ascii_lowercase();
-        if raw == "inf" || raw == "+inf" || raw == "infinity" {
+        let raw = &row.fields[col];
+        if ["inf", "+inf", "infinity"]
+            .iter()
+            .any(|w| raw.eq_ignore_ascii_case(w))
+        {
             return Ok(f64::INFINITY);
         }
         self.number_where(
@@ -361,18 +382,18 @@ mod tests {
         let t = Table::parse("f.csv", "id,v\n\"a\nb\n# not a comment\",1\n# c\n\"x\",2\n").unwrap();
         assert_eq!(t.header_line, 1);
         assert_eq!(t.rows[0].line, 2);
-        assert_eq!(t.rows[0].fields[0], "a\nb\n# not a comment");
+        assert_eq!(&t.rows[0].fields[0], "a\nb\n# not a comment");
         assert_eq!(t.rows[1].line, 6);
         // A comment that opens a quote does not swallow the following data.
         let t = Table::parse("f.csv", "a,b\n  # x,\"unbalanced\n1,2\n3,4\n").unwrap();
         assert_eq!(t.rows.len(), 2);
         assert_eq!(t.rows[0].line, 3);
-        assert_eq!(t.rows[0].fields, ["1", "2"]);
+        assert_eq!(t.rows[0].fields, vec!["1", "2"]);
         assert_eq!(t.rows[1].line, 4);
         // Quotes, commas and doubled quotes in a field; a byte-order mark before the header.
         let t = Table::parse("f.csv", "\u{feff}id,v\n\"a, \"\"b\"\"\",1\n").unwrap();
         assert_eq!(t.headers, ["id", "v"]);
-        assert_eq!(t.rows[0].fields[0], "a, \"b\"");
+        assert_eq!(&t.rows[0].fields[0], "a, \"b\"");
     }
 
     #[test]

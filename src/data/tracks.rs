@@ -72,7 +72,7 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
     let mut accs: Vec<Acc> = Vec::new();
     let mut index: HashMap<String, usize> = HashMap::new();
     for row in &table.rows {
-        let id = row.fields[id_col].clone();
+        let id = row.fields[id_col].to_string();
         if id.is_empty() {
             return Err(table.cell_error(row, id_col, "empty collision id"));
         }
@@ -85,7 +85,7 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
         let d2 = table.number_where(row, d2_col, positive, "a diameter > 0 (mm)")? * 1e-3;
         let post = match phase_col {
             None => None,
-            Some(c) => match row.fields[c].as_str() {
+            Some(c) => match &row.fields[c] {
                 "pre" => Some(false),
                 "post" => Some(true),
                 other => {

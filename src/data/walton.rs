@@ -190,7 +190,7 @@ pub fn read_collisions(
         }
         records.push(CollisionRecord {
             line: row.line,
-            id: id_col.map(|c| row.fields[c].clone()),
+            id: id_col.map(|c| row.fields[c].to_string()),
             pre,
             post,
         });

@@ -203,7 +203,9 @@ impl FitData {
                 o.v_n_m_s.to_bits(),
             )
         };
-        let mut index: std::collections::HashMap<_, usize> = std::collections::HashMap::new();
+        // Sized for every row at once: growing by rehashing cost more than the merge itself.
+        let mut index: std::collections::HashMap<_, usize> =
+            std::collections::HashMap::with_capacity(self.obs.len());
         let mut point_of_row = Vec::with_capacity(self.obs.len());
         let mut first_row = Vec::new();
         for (i, o) in self.obs.iter().enumerate() {

@@ -74,7 +74,11 @@ impl Sheet {
         let t = Table::parse("base", text).expect("the base data are valid");
         Sheet {
             header: t.headers,
-            rows: t.rows.into_iter().map(|r| r.fields).collect(),
+            rows: t
+                .rows
+                .into_iter()
+                .map(|r| r.fields.iter().map(str::to_string).collect())
+                .collect(),
             comments: false,
             crlf: false,
             bom: false,
