@@ -291,9 +291,9 @@ fn figure(centre: &[CentreRow], e_rows: &[ERow]) -> Result<String, String> {
             references: vec![],
         },
     ];
-    accuracy_svg(
+    Ok(accuracy_svg(
         &panels,
         2,
         "Rendered frames: centre error by method (paper's camera, 8-bit, bright on dark)",
-    )
+    )?)
 }

@@ -66,6 +66,8 @@ fn input(e: ExportError) -> Failure {
         ExportError::Input(m) => Failure::Input(m),
         // LAMMPS ran and disagrees: a numerical failure, not bad input.
         ExportError::Verify { message, .. } => Failure::Numerical(message),
+        // The curves of laws.svg could not be evaluated or drawn: not the caller's input.
+        ExportError::Plot(e) => Failure::Numerical(e.to_string()),
     }
 }
 

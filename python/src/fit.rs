@@ -74,7 +74,7 @@ impl Fitted {
                 &self.vm_method,
                 &title,
             )
-            .map_err(Failure::Numerical)
+            .map_err(|e| Failure::Numerical(e.to_string()))
         })
     }
 
@@ -82,7 +82,8 @@ impl Fitted {
     fn residuals_svg(&self, py: Python<'_>, title: &str) -> PyResult<String> {
         let title = title.to_string();
         run_detached(py, || {
-            residuals_svg(&self.input.data, &self.set, &title).map_err(Failure::Numerical)
+            residuals_svg(&self.input.data, &self.set, &title)
+                .map_err(|e| Failure::Numerical(e.to_string()))
         })
     }
 

@@ -79,12 +79,9 @@ pub fn run(args: Args) -> CliResult {
         load_average()
     );
     let summary = report.summary_markdown(&machine);
-    let wp_svg = plot::bench::work_precision_svg(&report)
-        .map_err(|e| format!("drawing work_precision.svg: {e}"))?;
-    let st_svg =
-        plot::bench::stability_svg(&report).map_err(|e| format!("drawing stability.svg: {e}"))?;
-    let fit_svg = plot::bench::fit_accuracy_svg(&report)
-        .map_err(|e| format!("drawing fit_accuracy.svg: {e}"))?;
+    let wp_svg = plot::bench::work_precision_svg(&report)?;
+    let st_svg = plot::bench::stability_svg(&report)?;
+    let fit_svg = plot::bench::fit_accuracy_svg(&report)?;
     let files = vec![
         (
             args.out.join("work_precision.csv"),

@@ -2,6 +2,7 @@
 //! with the exported laws (constant e, the closest viscoelastic law), and their deviations from
 //! the fitted curve with the tolerance band.
 
+use super::{PlotError, PlotFailure};
 use crate::dem::translate::Translation;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -28,16 +29,20 @@ fn tick(v: &f64) -> String {
     }
 }
 
-fn err<E: std::fmt::Display>(e: E) -> String {
-    format!("drawing laws.svg: {e}")
+fn err<E: std::fmt::Display>(e: E) -> PlotFailure {
+    PlotFailure::backend(e)
 }
 
 /// Renders laws.svg (needs a speed range in the translation).
-pub fn laws_svg(tr: &Translation, title: &str) -> Result<String, String> {
+pub fn laws_svg(tr: &Translation, title: &str) -> Result<String, PlotError> {
+    draw(tr, title).map_err(PlotError::of("laws.svg"))
+}
+
+fn draw(tr: &Translation, title: &str) -> Result<String, PlotFailure> {
     let range = tr
         .request
         .range
-        .ok_or("laws.svg needs a speed range (--v-range)")?;
+        .ok_or(PlotFailure::Missing("a speed range (--v-range)"))?;
     let grid = range.log_grid(SAMPLES);
     let eta = tr.viscoelastic.eta_mean;
     let mut curves = Vec::new();
@@ -45,8 +50,8 @@ pub fn laws_svg(tr: &Translation, title: &str) -> Result<String, String> {
         let mut fitted = Vec::new();
         let mut vm = Vec::new();
         for &v in &grid {
-            fitted.push((v, tr.e_fitted(p, v).map_err(|e| e.to_string())?));
-            vm.push((v, tr.e_viscoelastic(p, v, eta).map_err(|e| e.to_string())?));
+            fitted.push((v, tr.e_fitted(p, v)?));
+            vm.push((v, tr.e_viscoelastic(p, v, eta)?));
         }
         curves.push(Curve {
             label: pair.label(),
@@ -188,7 +193,7 @@ fn legend_row(
     curves: &[Curve],
     eta: f64,
     tol: Option<f64>,
-) -> Result<(), String> {
+) -> Result<(), PlotFailure> {
     let font = ("sans-serif", 18).into_font();
     let y = 18;
     let mut x = 20;

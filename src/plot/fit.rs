@@ -1,6 +1,7 @@
 //! Figures of `restitution fit`: `fig7.svg` (the paper's Fig. 7 with the fitted models) and
 //! `residuals.svg` (normalised residuals of every fitted model).
 
+use super::{PlotError, PlotFailure};
 use crate::fit::dataset::{FitData, Group};
 use crate::fit::engine::FitSet;
 use crate::fit::models::{ModelKind, predict_e};
@@ -23,7 +24,7 @@ fn draw_markers<'a, DB, CT>(
     g: usize,
     size: i32,
     c: RGBColor,
-) -> Result<(), String>
+) -> Result<(), PlotFailure>
 where
     DB: DrawingBackend + 'a,
     CT: CoordTranslate<From = (f64, f64)>,
@@ -68,7 +69,7 @@ fn draw_legend(
     area: &DrawingArea<SVGBackend, Shift>,
     columns: &[(i32, Vec<(Sample, String)>)],
     font: u32,
-) -> Result<(), String> {
+) -> Result<(), PlotFailure> {
     let row_h = font as i32 + 10;
     let placed = columns.iter().flat_map(|(x0, entries)| {
         entries
@@ -208,8 +209,8 @@ fn describe(f: &FitResult) -> String {
     parts.join(", ")
 }
 
-fn svg_err(e: impl std::fmt::Display) -> String {
-    format!("drawing the figure failed: {e}")
+fn svg_err(e: impl std::fmt::Display) -> PlotFailure {
+    PlotFailure::backend(e)
 }
 
 /// `fig7.svg`: e against v_n on log-log axes. Data with error bars, one colour and marker per
@@ -222,7 +223,17 @@ pub fn fig7_svg(
     rule: ContactEnd,
     method: &VmMethod,
     title: &str,
-) -> Result<String, String> {
+) -> Result<String, PlotError> {
+    draw_fig7(data, set, rule, method, title).map_err(PlotError::of("fig7.svg"))
+}
+
+fn draw_fig7(
+    data: &FitData,
+    set: &FitSet,
+    rule: ContactEnd,
+    method: &VmMethod,
+    title: &str,
+) -> Result<String, PlotFailure> {
     let groups = data.groups();
     let (mut vlo, mut vhi) = (f64::INFINITY, 0.0f64);
     let (mut elo, mut ehi) = (f64::INFINITY, 0.0f64);
@@ -383,7 +394,11 @@ pub fn fig7_svg(
 
 /// `residuals.svg`: (e - model)/sigma against v_n for every fitted model, one panel each, with
 /// the lines 0 and +-2.
-pub fn residuals_svg(data: &FitData, set: &FitSet, title: &str) -> Result<String, String> {
+pub fn residuals_svg(data: &FitData, set: &FitSet, title: &str) -> Result<String, PlotError> {
+    draw_residuals(data, set, title).map_err(PlotError::of("residuals.svg"))
+}
+
+fn draw_residuals(data: &FitData, set: &FitSet, title: &str) -> Result<String, PlotFailure> {
     let groups = data.groups();
     let n = set.fits.len().max(1);
     let (mut vlo, mut vhi) = (f64::INFINITY, 0.0f64);

@@ -3,6 +3,7 @@
 //! markers. Axes in pixels, x right, y up. The frame is embedded as a PNG (given already
 //! encoded, so this module needs no image codec).
 
+use super::{PlotError, PlotFailure};
 use crate::frames::track::FrameResult;
 use plotters::prelude::*;
 
@@ -34,7 +35,17 @@ pub fn overlay_svg(
     height: usize,
     frame: &FrameResult,
     title: &str,
-) -> Result<String, String> {
+) -> Result<String, PlotError> {
+    draw(png, width, height, frame, title).map_err(PlotError::of(format!("the overlay: {title}")))
+}
+
+fn draw(
+    png: &[u8],
+    width: usize,
+    height: usize,
+    frame: &FrameResult,
+    title: &str,
+) -> Result<String, PlotFailure> {
     let (w, h) = (width as f64, height as f64);
     // Screen pixels per image pixel: the larger side about 720 px.
     let k = 720.0 / w.max(h);
@@ -45,7 +56,7 @@ pub fn overlay_svg(
     {
         let root = SVGBackend::with_string(&mut svg, (pw + left + right, ph + bottom + top))
             .into_drawing_area();
-        let e = |e: DrawingAreaErrorKind<_>| format!("drawing the overlay: {e}");
+        let e = |e: DrawingAreaErrorKind<_>| PlotFailure::backend(e);
         root.fill(&WHITE).map_err(e)?;
         let mut chart = ChartBuilder::on(&root)
             .caption(title, ("sans-serif", 22))
@@ -123,12 +134,12 @@ pub fn overlay_svg(
         let x0 = area.0.end + 20;
         let mut y = area.1.start + 10;
         let font = ("sans-serif", 15).into_font();
-        let mut entry = |text: String, glyph: &dyn Fn(i32, i32) -> Result<(), String>| {
+        let mut entry = |text: String, glyph: &dyn Fn(i32, i32) -> Result<(), PlotFailure>| {
             glyph(x0 + 8, y)?;
             root.draw(&Text::new(text, (x0 + 24, y - 7), font.clone()))
                 .map_err(e)?;
             y += 24;
-            Ok::<(), String>(())
+            Ok::<(), PlotFailure>(())
         };
         for (s, obs) in frame.spheres.iter().enumerate() {
             let Some(o) = obs else { continue };
@@ -179,7 +190,9 @@ pub fn overlay_svg(
     let at = svg
         .find("<rect")
         .and_then(|i| svg[i..].find("/>").map(|j| i + j + 2))
-        .ok_or("drawing the overlay: no background in the SVG")?;
+        .ok_or(PlotFailure::Backend(
+            "the SVG has no background rectangle to put the frame on".into(),
+        ))?;
     let image = format!(
         "\n<image x=\"{}\" y=\"{}\" width=\"{}\" height=\"{}\" preserveAspectRatio=\"none\" style=\"image-rendering:pixelated\" href=\"data:image/png;base64,{}\"/>",
         area.0.start,

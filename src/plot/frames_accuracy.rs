@@ -2,6 +2,7 @@
 //! size, blur, speed), one line per method, with horizontal reference levels (the paper's half
 //! pixel, the aims).
 
+use super::{PlotError, PlotFailure};
 use plotters::prelude::*;
 
 /// One line of a panel: a label and its (x, y) points (y > 0; log axes).
@@ -40,7 +41,11 @@ fn fmt_axis(x: f64) -> String {
 
 /// Renders panels in a grid of `columns` as one SVG; every y axis is logarithmic. Series with the
 /// same label have the same colour in every panel.
-pub fn accuracy_svg(panels: &[Panel], columns: usize, title: &str) -> Result<String, String> {
+pub fn accuracy_svg(panels: &[Panel], columns: usize, title: &str) -> Result<String, PlotError> {
+    draw(panels, columns, title).map_err(PlotError::of("the accuracy figure"))
+}
+
+fn draw(panels: &[Panel], columns: usize, title: &str) -> Result<String, PlotFailure> {
     let columns = columns.max(1);
     let rows = panels.len().div_ceil(columns);
     let mut labels: Vec<&str> = Vec::new();
@@ -55,7 +60,7 @@ pub fn accuracy_svg(panels: &[Panel], columns: usize, title: &str) -> Result<Str
     {
         let (w, h) = (640 * columns as u32, 60 + 470 * rows as u32);
         let root = SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area();
-        let e = |e: DrawingAreaErrorKind<_>| format!("drawing the accuracy figure: {e}");
+        let e = |e: DrawingAreaErrorKind<_>| PlotFailure::backend(e);
         root.fill(&WHITE).map_err(e)?;
         let root = root.titled(title, ("sans-serif", 26)).map_err(e)?;
         let areas = root.split_evenly((rows, columns));
@@ -74,7 +79,10 @@ pub fn accuracy_svg(panels: &[Panel], columns: usize, title: &str) -> Result<Str
                 .filter(|x| x.is_finite() && (!panel.log_x || *x > 0.0))
                 .collect();
             if ys.is_empty() || xs.is_empty() {
-                return Err(format!("panel '{}': nothing to draw", panel.title));
+                return Err(PlotFailure::NothingToDraw(format!(
+                    "panel '{}' has no finite point",
+                    panel.title
+                )));
             }
             let (y0, y1) = ys
                 .iter()

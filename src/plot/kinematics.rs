@@ -1,11 +1,16 @@
 //! The camera study: relative scatter and bias of measured e against the normal impact speed,
 //! one line per camera, solid for free quadratic fits, dashed for fixed-gravity fits.
 
+use super::{PlotError, PlotFailure};
 use crate::experiment::StudyPoint;
 use plotters::prelude::*;
 
 /// Renders the camera study as an SVG string (two panels: scatter, bias).
-pub fn camera_study_svg(points: &[StudyPoint], title: &str) -> Result<String, String> {
+pub fn camera_study_svg(points: &[StudyPoint], title: &str) -> Result<String, PlotError> {
+    draw(points, title).map_err(PlotError::of("camera_study.svg"))
+}
+
+fn draw(points: &[StudyPoint], title: &str) -> Result<String, PlotFailure> {
     let mut cameras: Vec<&str> = Vec::new();
     for p in points {
         if !cameras.contains(&p.camera.as_str()) {
@@ -34,12 +39,14 @@ pub fn camera_study_svg(points: &[StudyPoint], title: &str) -> Result<String, St
         .map(|p| (100.0 * p.bias).abs())
         .fold(0.5, f64::max);
     if !(v_min > 0.0 && s_min > 0.0 && s_max >= s_min) {
-        return Err("camera study: no measurable point to draw".into());
+        return Err(PlotFailure::NothingToDraw(
+            "no measurable point in the camera study".into(),
+        ));
     }
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (1300, 620)).into_drawing_area();
-        let e = |e: DrawingAreaErrorKind<_>| format!("drawing camera_study.svg: {e}");
+        let e = |e: DrawingAreaErrorKind<_>| PlotFailure::backend(e);
         root.fill(&WHITE).map_err(e)?;
         let root = root.titled(title, ("sans-serif", 26)).map_err(e)?;
         let (left, right) = root.split_horizontally(650);

@@ -24,6 +24,54 @@ pub fn colour(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
 
+/// Why a figure could not be drawn: which figure, and the kind of failure as a field.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("drawing {figure}: {kind}")]
+pub struct PlotError {
+    /// The figure, as its file is named (`fig7.svg`) or described (`the overlay of frame 12`).
+    pub figure: String,
+    pub kind: PlotFailure,
+}
+
+/// The kinds of [`PlotError`].
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PlotFailure {
+    /// plotters' SVG backend refused an element (its message).
+    #[error("{0}")]
+    Backend(String),
+    /// No point of the data can be placed on the figure's axes (what is empty).
+    #[error("nothing to draw: {0}")]
+    NothingToDraw(String),
+    /// The figure needs an input it was not given (which).
+    #[error("it needs {0}")]
+    Missing(&'static str),
+    /// A model curve could not be evaluated.
+    #[error("{0}")]
+    Model(#[from] crate::error::Error),
+}
+
+impl PlotFailure {
+    /// The backend's error as a failure (for `map_err`).
+    pub fn backend(e: impl std::fmt::Display) -> Self {
+        PlotFailure::Backend(e.to_string())
+    }
+}
+
+impl PlotError {
+    /// Names the figure a failure happened in (for `map_err`).
+    pub fn of(figure: impl Into<String>) -> impl FnOnce(PlotFailure) -> PlotError {
+        let figure = figure.into();
+        move |kind| PlotError { figure, kind }
+    }
+}
+
+/// The command line reports every error as one line of text.
+impl From<PlotError> for String {
+    fn from(e: PlotError) -> String {
+        e.to_string()
+    }
+}
+
 #[cfg(feature = "io")]
 pub mod bench;
 /// Draws a chart's legend in the house style: a nearly opaque white box with a grey border, at
@@ -32,7 +80,7 @@ pub fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
     chart: &mut ChartContext<'a, DB, CT>,
     position: SeriesLabelPosition,
     font_px: u32,
-) -> Result<(), String> {
+) -> Result<(), PlotFailure> {
     chart
         .configure_series_labels()
         .position(position)
@@ -40,7 +88,7 @@ pub fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
         .background_style(WHITE.mix(0.9))
         .border_style(BLACK.mix(0.5))
         .draw()
-        .map_err(|e| format!("drawing a legend: {e}"))
+        .map_err(|e| PlotFailure::Backend(format!("a legend: {e}")))
 }
 
 pub mod export;
@@ -49,3 +97,37 @@ pub mod frames;
 pub mod frames_accuracy;
 pub mod kinematics;
 pub mod walton;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn failures_name_the_figure_and_their_kind() {
+        let e = kinematics::camera_study_svg(&[], "no points").unwrap_err();
+        assert_eq!(e.figure, "camera_study.svg");
+        assert!(matches!(e.kind, PlotFailure::NothingToDraw(_)), "{e:?}");
+        assert_eq!(
+            e.to_string(),
+            "drawing camera_study.svg: nothing to draw: no measurable point in the camera study"
+        );
+        let nan_only = frames_accuracy::Panel {
+            title: "centre error".into(),
+            x_desc: "x".into(),
+            y_desc: "y".into(),
+            log_x: false,
+            lines: vec![frames_accuracy::Line {
+                label: "fit".into(),
+                points: vec![(1.0, f64::NAN)],
+            }],
+            references: vec![],
+        };
+        let e = frames_accuracy::accuracy_svg(&[nan_only], 1, "t").unwrap_err();
+        assert_eq!(
+            e.kind,
+            PlotFailure::NothingToDraw("panel 'centre error' has no finite point".into())
+        );
+        let text: String = e.into();
+        assert!(text.starts_with("drawing the accuracy figure: "), "{text}");
+    }
+}

@@ -1,6 +1,7 @@
 //! The paper's Fig. 6: tangential restitution beta against psi = -v_n/|v_s| (the cotangent of
 //! the angle of incidence), with the fitted Walton hinge beta = min(-1 + s psi, beta_0).
 
+use super::{PlotError, PlotFailure};
 use plotters::prelude::*;
 
 /// One measured collision on the figure.
@@ -32,7 +33,11 @@ const ROLLING: RGBColor = RGBColor(214, 95, 14);
 /// Renders Fig. 6 as an SVG string. The psi axis ends just past the data unless a few
 /// near-head-on collisions (psi far beyond the rest) would squeeze everything else into the left
 /// edge: then it ends past the 95th percentile and the caption counts the points not shown.
-pub fn fig6_svg(points: &[Fig6Point], fit: &Fig6Fit, title: &str) -> Result<String, String> {
+pub fn fig6_svg(points: &[Fig6Point], fit: &Fig6Fit, title: &str) -> Result<String, PlotError> {
+    draw(points, fit, title).map_err(PlotError::of("fig6.svg"))
+}
+
+fn draw(points: &[Fig6Point], fit: &Fig6Fit, title: &str) -> Result<String, PlotFailure> {
     let mut psis: Vec<f64> = points
         .iter()
         .map(|p| p.psi)
@@ -63,7 +68,7 @@ pub fn fig6_svg(points: &[Fig6Point], fit: &Fig6Fit, title: &str) -> Result<Stri
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (900, 620)).into_drawing_area();
-        let e = |e: DrawingAreaErrorKind<_>| format!("drawing fig6.svg: {e}");
+        let e = |e: DrawingAreaErrorKind<_>| PlotFailure::backend(e);
         root.fill(&WHITE).map_err(e)?;
         let caption = if hidden > 0 {
             format!("{title} ({hidden} collisions with ψ > {x_max:.2} not shown)")

@@ -39,6 +39,10 @@ pub enum ExportError {
     /// LAMMPS ran but its e differs from the toolkit's; `table` shows every collision.
     #[error("{message}")]
     Verify { message: String, table: String },
+    /// laws.svg could not be drawn.
+    #[cfg(feature = "plot")]
+    #[error(transparent)]
+    Plot(#[from] crate::plot::PlotError),
 }
 
 impl From<String> for ExportError {

@@ -3,6 +3,7 @@
 use super::{Area, err_str};
 use crate::bench::BenchReport;
 use crate::bench::stability::{Cell, Outcome};
+use crate::plot::{PlotError, PlotFailure};
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
@@ -130,7 +131,7 @@ fn map_panel(
     cells: &[&Cell],
     x_of: impl Fn(&Cell) -> f64,
     mark: Option<(f64, &str)>,
-) -> Result<(), String> {
+) -> Result<(), PlotFailure> {
     let rows = map_rows(cells);
     let mut xs: Vec<f64> = cells.iter().map(|c| x_of(c)).collect();
     xs.sort_by(|a, b| a.total_cmp(b));
@@ -202,7 +203,11 @@ fn map_panel(
 
 /// `stability.svg`: for each method, setting and rule, the outcome at every kappa (top) and u
 /// (bottom), coloured by how it failed.
-pub fn stability_svg(report: &BenchReport) -> Result<String, String> {
+pub fn stability_svg(report: &BenchReport) -> Result<String, PlotError> {
+    draw(report).map_err(PlotError::of("stability.svg"))
+}
+
+fn draw(report: &BenchReport) -> Result<String, PlotFailure> {
     let vm: Vec<&Cell> = report.cells.iter().filter(|c| c.model == "vm").collect();
     let pm: Vec<&Cell> = report.cells.iter().filter(|c| c.model == "pm").collect();
     let n_vm = map_rows(&vm).len() as u32;

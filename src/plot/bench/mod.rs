@@ -3,6 +3,7 @@
 use crate::bench::fit_accuracy::FitMethodRow;
 
 use crate::bench::{BenchReport, WpRow};
+use crate::plot::{PlotError, PlotFailure};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
@@ -39,8 +40,8 @@ fn floor(e: f64) -> f64 {
     e.max(ERROR_FLOOR)
 }
 
-fn err_str<E: std::fmt::Debug>(e: E) -> String {
-    format!("{e:?}")
+fn err_str<E: std::fmt::Debug>(e: E) -> PlotFailure {
+    PlotFailure::Backend(format!("{e:?}"))
 }
 
 /// Methods in the order of first appearance.
@@ -62,7 +63,7 @@ fn draw_lines<X: Fn(&WpRow) -> f64, Y: Fn(&WpRow) -> f64>(
     y: Y,
     dashed: bool,
     label_suffix: &str,
-) -> Result<(), String> {
+) -> Result<(), PlotFailure> {
     for m in methods_of(rows.iter().copied()) {
         let color = method_color(&m);
         let mut pts: Vec<(f64, f64)> = rows
@@ -114,7 +115,7 @@ fn log_panel<'a>(
     y_desc: &str,
     x: (f64, f64),
     y: (f64, f64),
-) -> Result<LogChart<'a>, String> {
+) -> Result<LogChart<'a>, PlotFailure> {
     let mut chart = ChartBuilder::on(area)
         .caption(title, ("sans-serif", 26))
         .margin(12)
@@ -150,7 +151,11 @@ fn range_of(vals: impl Iterator<Item = f64>, pad: f64) -> (f64, f64) {
 
 /// `work_precision.svg`: (a) vm error in e against time per evaluation, (b) against right-hand-side
 /// evaluations, (c) pm relative errors against time, (d) RK4's error against its step.
-pub fn work_precision_svg(report: &BenchReport) -> Result<String, String> {
+pub fn work_precision_svg(report: &BenchReport) -> Result<String, PlotError> {
+    draw_work_precision(report).map_err(PlotError::of("work_precision.svg"))
+}
+
+fn draw_work_precision(report: &BenchReport) -> Result<String, PlotFailure> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (1600, 1250)).into_drawing_area();
@@ -354,7 +359,11 @@ type PanelSpec = (
 /// `fit_accuracy.svg`: (a) the fitted eta's error and (b) the model error over the data, against
 /// the fit's wall time, per evaluation method; the default (cheapest method whose model error is
 /// below 1% of the smallest error bar) ringed.
-pub fn fit_accuracy_svg(report: &BenchReport) -> Result<String, String> {
+pub fn fit_accuracy_svg(report: &BenchReport) -> Result<String, PlotError> {
+    draw_fit_accuracy(report).map_err(PlotError::of("fit_accuracy.svg"))
+}
+
+fn draw_fit_accuracy(report: &BenchReport) -> Result<String, PlotFailure> {
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (1600, 700)).into_drawing_area();
