@@ -11,6 +11,7 @@ class InputError(ValueError):
     line: Optional[int]
     column: Optional[str]
     detail: Optional[str]
+    kind: Optional[str]  # io, format, schema or value
 
 class NumericalError(RuntimeError): ...
 

@@ -82,7 +82,7 @@ class Source:
         if col is not None:
             where += f": column '{col}'"
         new = InputError(f"{where}: {getattr(err, 'detail', err)}")
-        for a in ("path", "column", "detail"):
+        for a in ("path", "column", "detail", "kind"):
             setattr(new, a, getattr(err, a, None))
         new.line = line
         new.row = label

@@ -64,6 +64,9 @@ impl Doc {
 fn input(e: ExportError) -> Failure {
     match e {
         ExportError::Input(m) => Failure::Input(m),
+        ExportError::Data(d) => Failure::Data(d),
+        // LAMMPS missing or its output unreadable: not the caller's input.
+        ExportError::Engine(m) => Failure::Numerical(m),
         // LAMMPS ran and disagrees: a numerical failure, not bad input.
         ExportError::Verify { message, .. } => Failure::Numerical(message),
         // The curves of laws.svg could not be evaluated or drawn: not the caller's input.

@@ -82,6 +82,7 @@ impl Failure {
                 let _ = v.setattr("line", d.line);
                 let _ = v.setattr("column", d.column.clone());
                 let _ = v.setattr("detail", d.message.clone());
+                let _ = v.setattr("kind", d.kind.to_string());
                 err
             }
         }

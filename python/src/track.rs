@@ -5,11 +5,22 @@
 use crate::{Failure, Outcome, run_detached};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use restitution::data::frames::job::{TrackRequest, track_dirs, track_files, warnings};
+use restitution::data::frames::job::{
+    TrackJobError, TrackRequest, track_dirs, track_files, warnings,
+};
 use restitution::data::frames::{results_json_text, tracks_csv};
 use restitution::data::report::track::to_table;
 use restitution::data::{ArgStyle, write_all_atomic};
 use std::path::PathBuf;
+
+fn failure(e: TrackJobError) -> Failure {
+    match e {
+        TrackJobError::Data(d) => Failure::Data(d),
+        // An overlay that cannot be drawn is not the caller's input.
+        TrackJobError::Plot(p) => Failure::Numerical(p.to_string()),
+        TrackJobError::Input(_) | TrackJobError::Tracking(_) => Failure::Input(e.to_string()),
+    }
+}
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(track, m)?)?;
@@ -43,10 +54,10 @@ fn track<'py>(
             d_mm,
             strict,
         };
-        let results = track_dirs(&dirs, &request, &|| {}).map_err(Failure::Input)?;
+        let results = track_dirs(&dirs, &request, &|| {}).map_err(failure)?;
         if let Some(dir) = &out {
             let files: Vec<(PathBuf, Vec<u8>)> = track_files(&results)
-                .map_err(Failure::Input)?
+                .map_err(failure)?
                 .into_iter()
                 .map(|(name, bytes)| (dir.join(name), bytes))
                 .collect();

@@ -45,7 +45,7 @@ def test_file_errors_carry_the_place(tmp_path, monkeypatch):
     with pytest.raises(rs.InputError) as info:
         rs.fit("bad.csv", "nylon")
     e = info.value
-    assert (e.path, e.line, e.column) == ("bad.csv", 5, "e")
+    assert (e.path, e.line, e.column, e.kind) == ("bad.csv", 5, "e", "value")
     assert str(e) == "bad.csv:5: column 'e': 'x' is not a number"
 
 
@@ -54,6 +54,7 @@ def test_missing_file_and_strict_give_the_cli_message(tmp_path, monkeypatch):
     with pytest.raises(ValueError) as info:
         rs.fit("missing.csv", "nylon")
     assert str(info.value) == cli_error("fit", "missing.csv", "--material", "nylon")
+    assert info.value.kind == "io"
     write(tmp_path, "hi.csv", "d_mm,v_n_m_s,e\n12.7,1,1.02\n12.7,2,0.9\n12.7,3,0.9\n")
     with pytest.raises(ValueError) as info:
         rs.fit("hi.csv", "nylon", strict=True)

@@ -73,13 +73,14 @@ pub fn run(args: Args) -> CliResult {
         ProgressStyle::with_template("{bar:40} {pos}/{len} frames {elapsed}")
             .map_err(|e| e.to_string())?,
     );
-    let results = track_dirs(&args.dirs, &request, &|| bar.inc(1))?;
+    let results = track_dirs(&args.dirs, &request, &|| bar.inc(1)).map_err(|e| e.to_string())?;
     bar.finish_and_clear();
     for w in warnings(&results) {
         warn(w);
     }
     if let Some(out) = &args.out {
-        let files: Vec<(PathBuf, Vec<u8>)> = track_files(&results)?
+        let files: Vec<(PathBuf, Vec<u8>)> = track_files(&results)
+            .map_err(|e| e.to_string())?
             .into_iter()
             .map(|(name, bytes)| (out.join(name), bytes))
             .collect();

@@ -14,7 +14,7 @@ pub mod plan;
 pub mod report;
 pub mod run;
 
-use super::DataError;
+use super::{DataError, DataFailure};
 use crate::contact::Material;
 use crate::dem::law::FittedCurve;
 use crate::fit::models::ModelKind;
@@ -52,11 +52,12 @@ pub struct WaltonParams {
     pub converged: bool,
 }
 
-fn err(path: &str, message: impl Into<String>) -> DataError {
+fn err(path: &str, kind: DataFailure, message: impl Into<String>) -> DataError {
     DataError {
         path: path.to_string(),
         line: None,
         column: None,
+        kind,
         message: message.into(),
     }
 }
@@ -64,8 +65,8 @@ fn err(path: &str, message: impl Into<String>) -> DataError {
 /// Reads a JSON file; syntax errors name the line and column.
 fn read_json(path: &Path) -> Result<(String, Value), DataError> {
     let shown = path.display().to_string();
-    let text =
-        std::fs::read_to_string(path).map_err(|e| err(&shown, format!("cannot read: {e}")))?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| err(&shown, DataFailure::Io, format!("cannot read: {e}")))?;
     parse_json(&shown, &text)
 }
 
@@ -75,6 +76,7 @@ fn parse_json(name: &str, text: &str) -> Result<(String, Value), DataError> {
         path: name.to_string(),
         line: Some(e.line()),
         column: None,
+        kind: DataFailure::Format,
         message: format!("not valid JSON (column {}): {e}", e.column()),
     })?;
     Ok((name.to_string(), v))
@@ -84,9 +86,13 @@ fn parse_json(name: &str, text: &str) -> Result<(String, Value), DataError> {
 fn at<'a>(path: &str, v: &'a Value, keys: &str) -> Result<&'a Value, DataError> {
     let mut cur = v;
     for k in keys.split('.') {
-        cur = cur
-            .get(k)
-            .ok_or_else(|| err(path, format!("field '{keys}' is missing")))?;
+        cur = cur.get(k).ok_or_else(|| {
+            err(
+                path,
+                DataFailure::Schema,
+                format!("field '{keys}' is missing"),
+            )
+        })?;
     }
     Ok(cur)
 }
@@ -98,6 +104,7 @@ fn number(path: &str, v: &Value, keys: &str) -> Result<f64, DataError> {
         Some(n) if n.is_finite() => Ok(n),
         _ => Err(err(
             path,
+            DataFailure::Value,
             format!("field '{keys}' is {x}, expected a finite number"),
         )),
     }
@@ -123,13 +130,13 @@ fn params_from_value(p: String, v: Value) -> Result<FitParamsFile, DataError> {
         number(p, &v, "material.poisson")?,
         number(p, &v, "material.density_kg_m3")?,
     )
-    .map_err(|e| err(p, format!("field 'material': {e}")))?;
+    .map_err(|e| err(p, DataFailure::Value, format!("field 'material': {e}")))?;
     let rule_text = at(p, &v, "contact_end")?
         .as_str()
-        .ok_or_else(|| err(p, "field 'contact_end' is not a string"))?;
+        .ok_or_else(|| err(p, DataFailure::Value, "field 'contact_end' is not a string"))?;
     let contact_end: ContactEnd = rule_text
         .parse()
-        .map_err(|e: String| err(p, format!("field 'contact_end': {e}")))?;
+        .map_err(|e: String| err(p, DataFailure::Value, format!("field 'contact_end': {e}")))?;
     let diameters_mm = match v.get("data").and_then(|d| d.get("diameters_mm")) {
         None => Vec::new(),
         Some(Value::Array(a)) => a
@@ -140,6 +147,7 @@ fn params_from_value(p: String, v: Value) -> Result<FitParamsFile, DataError> {
                     .ok_or_else(|| {
                         err(
                             p,
+                            DataFailure::Value,
                             format!("field 'data.diameters_mm' holds {x}, expected diameters > 0"),
                         )
                     })
@@ -148,6 +156,7 @@ fn params_from_value(p: String, v: Value) -> Result<FitParamsFile, DataError> {
         Some(x) => {
             return Err(err(
                 p,
+                DataFailure::Value,
                 format!("field 'data.diameters_mm' is {x}, expected a list"),
             ));
         }
@@ -158,18 +167,27 @@ fn params_from_value(p: String, v: Value) -> Result<FitParamsFile, DataError> {
         .map(str::to_string);
     let fits_v = at(p, &v, "fits")?
         .as_array()
-        .ok_or_else(|| err(p, "field 'fits' is not a list"))?;
+        .ok_or_else(|| err(p, DataFailure::Value, "field 'fits' is not a list"))?;
     let mut fits = Vec::new();
     for (k, f) in fits_v.iter().enumerate() {
         let model = f
             .get("model")
             .and_then(|m| m.as_str())
-            .ok_or_else(|| err(p, format!("fits[{k}]: field 'model' is missing")))?
+            .ok_or_else(|| {
+                err(
+                    p,
+                    DataFailure::Schema,
+                    format!("fits[{k}]: field 'model' is missing"),
+                )
+            })?
             .to_string();
-        let params_v = f
-            .get("params")
-            .and_then(|m| m.as_object())
-            .ok_or_else(|| err(p, format!("fits[{k}] ({model}): field 'params' is missing")))?;
+        let params_v = f.get("params").and_then(|m| m.as_object()).ok_or_else(|| {
+            err(
+                p,
+                DataFailure::Schema,
+                format!("fits[{k}] ({model}): field 'params' is missing"),
+            )
+        })?;
         let mut params = Vec::new();
         for (key, pv) in params_v {
             let value = match pv.get("value") {
@@ -177,6 +195,7 @@ fn params_from_value(p: String, v: Value) -> Result<FitParamsFile, DataError> {
                 Some(x) => Some(x.as_f64().filter(|n| n.is_finite()).ok_or_else(|| {
                     err(
                         p,
+                        DataFailure::Value,
                         format!("fits[{k}] ({model}): '{key}.value' is {x}, expected a number"),
                     )
                 })?),
@@ -195,7 +214,11 @@ fn params_from_value(p: String, v: Value) -> Result<FitParamsFile, DataError> {
         });
     }
     if fits.is_empty() {
-        return Err(err(p, "field 'fits' is empty: no fitted model to export"));
+        return Err(err(
+            p,
+            DataFailure::Schema,
+            "field 'fits' is empty: no fitted model to export",
+        ));
     }
     Ok(FitParamsFile {
         path: p.to_string(),
@@ -216,15 +239,19 @@ impl FitParamsFile {
             None => self.preferred.clone().ok_or_else(|| {
                 err(
                     &self.path,
+                    DataFailure::Schema,
                     "no 'preferred' model in the file: choose one with --model",
                 )
             })?,
         };
-        let kind: ModelKind = name.parse().map_err(|e: String| err(&self.path, e))?;
+        let kind: ModelKind = name
+            .parse()
+            .map_err(|e: String| err(&self.path, DataFailure::Value, e))?;
         let entry = self.fits.iter().find(|f| f.model == name).ok_or_else(|| {
             let have: Vec<&str> = self.fits.iter().map(|f| f.model.as_str()).collect();
             err(
                 &self.path,
+                DataFailure::Schema,
                 format!(
                     "model '{name}' was not fitted in this file (it has: {})",
                     have.join(", ")
@@ -240,12 +267,14 @@ impl FitParamsFile {
                 .ok_or_else(|| {
                     err(
                         &self.path,
+                        DataFailure::Schema,
                         format!("model '{name}': parameter '{}' is missing", spec.key),
                     )
                 })?;
             let x = value.ok_or_else(|| {
                 err(
                     &self.path,
+                    DataFailure::Value,
                     format!(
                         "model '{name}': parameter '{}' has no value (status {status}: the data \
                          do not determine it); export another model or give it as a flag",
@@ -255,8 +284,13 @@ impl FitParamsFile {
             })?;
             values.push(x);
         }
-        let curve = FittedCurve::new(kind, values, self.contact_end)
-            .map_err(|e| err(&self.path, format!("model '{name}': {e}")))?;
+        let curve = FittedCurve::new(kind, values, self.contact_end).map_err(|e| {
+            err(
+                &self.path,
+                DataFailure::Value,
+                format!("model '{name}': {e}"),
+            )
+        })?;
         Ok((curve, entry))
     }
 }
@@ -279,11 +313,16 @@ fn walton_from_value(p: String, v: Value) -> Result<WaltonParams, DataError> {
     let mu0 = number(p, &v, "mu0.value")?;
     let beta0 = number(p, &v, "beta0.value")?;
     if mu0 < 0.0 {
-        return Err(err(p, format!("field 'mu0.value' is {mu0}, expected >= 0")));
+        return Err(err(
+            p,
+            DataFailure::Value,
+            format!("field 'mu0.value' is {mu0}, expected >= 0"),
+        ));
     }
     if !(-1.0..=1.0).contains(&beta0) {
         return Err(err(
             p,
+            DataFailure::Value,
             format!("field 'beta0.value' is {beta0}, expected a number in [-1, 1]"),
         ));
     }

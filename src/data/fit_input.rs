@@ -11,7 +11,7 @@
 //! e > 1 (possible within the errors of a real measurement, so such rows are kept) and a
 //! diameter below 0.1 mm (probably metres). `strict` turns them into errors.
 
-use super::{DataError, Table};
+use super::{DataError, DataFailure, Table};
 use crate::contact::Material;
 use crate::fit::dataset::{FitData, Observation};
 use std::path::Path;
@@ -185,6 +185,7 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
         path: table.path.clone(),
         line: None,
         column: None,
+        kind: DataFailure::Value,
         message: e.to_string(),
     })?;
     let warnings = [tiny.finish(), above_one.finish()]

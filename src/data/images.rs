@@ -2,7 +2,7 @@
 //! collision per directory, ordered by the integer in each file name; decoded into
 //! [`GrayImage`] (intensities in [0, 1]; colour to luma with Rec. 709 weights).
 
-use super::DataError;
+use super::{DataError, DataFailure};
 use crate::frames::GrayImage;
 use std::path::{Path, PathBuf};
 
@@ -13,11 +13,12 @@ pub struct FrameFile {
     pub number: i64,
 }
 
-fn data_err(path: &Path, message: impl Into<String>) -> DataError {
+fn data_err(path: &Path, kind: DataFailure, message: impl Into<String>) -> DataError {
     DataError {
         path: path.display().to_string(),
         line: None,
         column: None,
+        kind,
         message: message.into(),
     }
 }
@@ -53,6 +54,7 @@ pub fn list_frames(dir: &Path) -> Result<Vec<FrameFile>, DataError> {
     if !dir.is_dir() {
         return Err(data_err(
             dir,
+            DataFailure::Io,
             if dir.exists() {
                 "is not a directory"
             } else {
@@ -60,10 +62,12 @@ pub fn list_frames(dir: &Path) -> Result<Vec<FrameFile>, DataError> {
             },
         ));
     }
-    let entries = std::fs::read_dir(dir).map_err(|e| data_err(dir, format!("cannot read: {e}")))?;
+    let entries = std::fs::read_dir(dir)
+        .map_err(|e| data_err(dir, DataFailure::Io, format!("cannot read: {e}")))?;
     let mut out: Vec<FrameFile> = Vec::new();
     for entry in entries {
-        let entry = entry.map_err(|e| data_err(dir, format!("cannot read: {e}")))?;
+        let entry =
+            entry.map_err(|e| data_err(dir, DataFailure::Io, format!("cannot read: {e}")))?;
         let path = entry.path();
         let name = entry.file_name().to_string_lossy().to_string();
         if name.starts_with('.') || !is_frame_file(&path) {
@@ -75,10 +79,11 @@ pub fn list_frames(dir: &Path) -> Result<Vec<FrameFile>, DataError> {
             .unwrap_or_default();
         let number = match frame_number(&stem) {
             Some(Ok(n)) => n,
-            Some(Err(e)) => return Err(data_err(&path, e)),
+            Some(Err(e)) => return Err(data_err(&path, DataFailure::Value, e)),
             None => {
                 return Err(data_err(
                     &path,
+                    DataFailure::Schema,
                     "no frame number in the file name (frames are ordered by the integer in their names)",
                 ));
             }
@@ -86,12 +91,17 @@ pub fn list_frames(dir: &Path) -> Result<Vec<FrameFile>, DataError> {
         out.push(FrameFile { path, number });
     }
     if out.is_empty() {
-        return Err(data_err(dir, "no PNG or TIFF frames in this directory"));
+        return Err(data_err(
+            dir,
+            DataFailure::Schema,
+            "no PNG or TIFF frames in this directory",
+        ));
     }
     out.sort_by(|a, b| a.number.cmp(&b.number).then(a.path.cmp(&b.path)));
     if let Some(w) = out.windows(2).find(|w| w[0].number == w[1].number) {
         return Err(data_err(
             &w[1].path,
+            DataFailure::Value,
             format!(
                 "frame number {} also in {}",
                 w[1].number,
@@ -105,20 +115,27 @@ pub fn list_frames(dir: &Path) -> Result<Vec<FrameFile>, DataError> {
 /// Decodes a PNG or TIFF file into a grey frame.
 pub fn read_gray(path: &Path) -> Result<GrayImage, DataError> {
     let img = image::ImageReader::open(path)
-        .map_err(|e| data_err(path, format!("cannot read: {e}")))?
+        .map_err(|e| data_err(path, DataFailure::Io, format!("cannot read: {e}")))?
         .with_guessed_format()
-        .map_err(|e| data_err(path, format!("cannot read: {e}")))?
+        .map_err(|e| data_err(path, DataFailure::Io, format!("cannot read: {e}")))?
         .decode()
-        .map_err(|e| data_err(path, format!("cannot decode the image: {e}")))?;
+        .map_err(|e| {
+            data_err(
+                path,
+                DataFailure::Format,
+                format!("cannot decode the image: {e}"),
+            )
+        })?;
     let luma = img.to_luma32f();
     let (w, h) = (luma.width() as usize, luma.height() as usize);
     if w == 0 || h == 0 {
-        return Err(data_err(path, "the image is empty"));
+        return Err(data_err(path, DataFailure::Format, "the image is empty"));
     }
     let pixels = luma.into_raw();
     if let Some(bad) = pixels.iter().position(|v| !v.is_finite()) {
         return Err(data_err(
             path,
+            DataFailure::Value,
             format!("pixel ({}, {}) is not a finite number", bad % w, bad / w),
         ));
     }
@@ -165,8 +182,9 @@ pub fn write_png16(path: &Path, img: &GrayImage) -> Result<(), DataError> {
             img.height as u32,
             image::ExtendedColorType::L16,
         )
-        .map_err(|e| data_err(path, format!("encoding a PNG: {e}")))?;
-    super::write_atomic(path, &out).map_err(|e| data_err(path, format!("cannot write: {e}")))
+        .map_err(|e| data_err(path, DataFailure::Format, format!("encoding a PNG: {e}")))?;
+    super::write_atomic(path, &out)
+        .map_err(|e| data_err(path, DataFailure::Io, format!("cannot write: {e}")))
 }
 
 #[cfg(test)]

@@ -44,13 +44,29 @@ impl ArgStyle {
     }
 }
 
-/// An input error pointing at a place in a file.
+/// An input error pointing at a place in a file, with the kind of failure as a field.
 #[derive(Debug, Clone, PartialEq)]
 pub struct DataError {
     pub path: String,
     pub line: Option<usize>,
     pub column: Option<String>,
+    pub kind: DataFailure,
     pub message: String,
+}
+
+/// The kinds of [`DataError`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, strum::IntoStaticStr, strum::Display)]
+#[strum(serialize_all = "snake_case")]
+pub enum DataFailure {
+    /// The file or directory could not be read or written (the system's reason in the message).
+    Io,
+    /// The bytes are not the format: CSV structure, text that is not UTF-8, JSON syntax, an
+    /// image that does not decode.
+    Format,
+    /// A column, field or file is missing, duplicated or empty.
+    Schema,
+    /// A value is not a number, is out of its range, or contradicts another.
+    Value,
 }
 
 impl fmt::Display for DataError {

@@ -12,7 +12,7 @@
 //! parses them as records. If such a line opens a quote that csv carries onto the next lines, the
 //! reader restarts on the following line, so that a comment can never swallow data.
 
-use super::{DataError, shown};
+use super::{DataError, DataFailure, shown};
 use std::fs;
 use std::path::Path;
 
@@ -122,6 +122,7 @@ fn not_utf8(
         path: path.to_string(),
         line: Some(line),
         column: Some(column.map_or_else(|| format!("field {}", j + 1), str::to_string)),
+        kind: DataFailure::Format,
         message: format!(
             "'{}' is not UTF-8 text (byte 0x{bad:02X}): save the file as UTF-8",
             shown(String::from_utf8_lossy(raw).trim())
@@ -139,6 +140,7 @@ impl Table {
             path: shown.clone(),
             line: None,
             column: None,
+            kind: DataFailure::Io,
             message: format!("cannot read: {e}"),
         })?;
         Table::parse_bytes(&shown, &bytes)
@@ -151,10 +153,11 @@ impl Table {
 
     /// As [`Table::read`], from bytes in memory (`path` is only used in messages).
     pub fn parse_bytes(path: &str, bytes: &[u8]) -> Result<Table, DataError> {
-        let err = |line: Option<usize>, message: String| DataError {
+        let err = |line: Option<usize>, kind: DataFailure, message: String| DataError {
             path: path.to_string(),
             line,
             column: None,
+            kind,
             message,
         };
         // A byte-order mark (as some spreadsheets write) is not part of the first header name.
@@ -172,9 +175,13 @@ impl Table {
         let mut rec = csv::ByteRecord::new();
         loop {
             let from = rdr.position().byte() as usize + base;
-            let more = rdr
-                .read_byte_record(&mut rec)
-                .map_err(|e| err(Some(line), format!("cannot parse: {e}")))?;
+            let more = rdr.read_byte_record(&mut rec).map_err(|e| {
+                err(
+                    Some(line),
+                    DataFailure::Format,
+                    format!("cannot parse: {e}"),
+                )
+            })?;
             if !more {
                 break;
             }
@@ -208,6 +215,7 @@ impl Table {
                     {
                         return Err(err(
                             Some(line),
+                            DataFailure::Schema,
                             format!("header names column '{}' twice", shown(dup.1)),
                         ));
                     }
@@ -217,6 +225,7 @@ impl Table {
                     if rec.len() != h.len() {
                         return Err(err(
                             Some(line),
+                            DataFailure::Format,
                             format!("has {} fields, the header has {}", rec.len(), h.len()),
                         ));
                     }
@@ -234,11 +243,17 @@ impl Table {
                 }
             }
         }
-        let (header_line, headers) =
-            header.ok_or_else(|| err(None, "no header line (the file is empty)".into()))?;
+        let (header_line, headers) = header.ok_or_else(|| {
+            err(
+                None,
+                DataFailure::Schema,
+                "no header line (the file is empty)".into(),
+            )
+        })?;
         if rows.is_empty() {
             return Err(err(
                 Some(header_line),
+                DataFailure::Schema,
                 "no data rows after the header".into(),
             ));
         }
@@ -261,6 +276,7 @@ impl Table {
             path: self.path.clone(),
             line: Some(self.header_line),
             column: Some(name.to_string()),
+            kind: DataFailure::Schema,
             message: format!(
                 "required column is missing (header has: {})",
                 shown(&self.headers.join(","))
@@ -274,6 +290,7 @@ impl Table {
             path: self.path.clone(),
             line: Some(row.line),
             column: Some(self.headers[col].clone()),
+            kind: DataFailure::Value,
             message: message.into(),
         }
     }
@@ -445,5 +462,26 @@ mod tests {
         assert!(t.number(&t.rows[0], 1).is_err());
         let e = t.require("c").unwrap_err();
         assert!(e.to_string().contains("column 'c'"), "{e}");
+    }
+
+    #[test]
+    fn each_failure_has_its_kind() {
+        let kind = |r: Result<Table, DataError>| r.unwrap_err().kind;
+        let missing = Path::new("/nonexistent/restitution-test/f.csv");
+        assert_eq!(kind(Table::read(missing)), DataFailure::Io);
+        assert_eq!(
+            kind(Table::parse_bytes("f", b"id\nx\xFF\n")),
+            DataFailure::Format
+        );
+        assert_eq!(kind(Table::parse("f", "a,b\n1,2,3\n")), DataFailure::Format);
+        assert_eq!(kind(Table::parse("f", "a,a\n1,2\n")), DataFailure::Schema);
+        assert_eq!(kind(Table::parse("f", "a,b\n")), DataFailure::Schema);
+        let t = Table::parse("f", "a,b\n1,x\n").unwrap();
+        assert_eq!(t.require("c").unwrap_err().kind, DataFailure::Schema);
+        assert_eq!(
+            t.number(&t.rows[0], 1).unwrap_err().kind,
+            DataFailure::Value
+        );
+        assert_eq!(DataFailure::Value.to_string(), "value");
     }
 }

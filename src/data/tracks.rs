@@ -7,7 +7,7 @@
 //! (a sphere whose spin was not measured) is read as NaN: the kinematics takes it as 0 and says
 //! so ([`crate::kinematics::batch`]).
 
-use super::{CsvOut, DataError, Table, fmt_num, shown};
+use super::{CsvOut, DataError, DataFailure, Table, fmt_num, shown};
 use crate::kinematics::Frame;
 use std::collections::{HashMap, HashSet};
 use std::path::Path;
@@ -177,6 +177,7 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
                     path: table.path.clone(),
                     line: Some(bad.1),
                     column: Some("phase".into()),
+                    kind: DataFailure::Value,
                     message: format!(
                         "a 'pre' frame comes after a 'post' frame in collision '{}'",
                         shown(&acc.track.id)

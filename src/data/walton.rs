@@ -3,7 +3,7 @@
 //! ([`write_collisions`]), so that every producer of such data (the generator, the kinematics
 //! command) writes exactly what the fit reads.
 
-use super::{CsvOut, DataError, Table, fmt_num};
+use super::{CsvOut, DataError, DataFailure, Table, fmt_num};
 use crate::contact::{Material, Sphere};
 use crate::fit::walton::CollisionRecord;
 use crate::models::walton::{self, Body, Measured, State, Target};
@@ -102,6 +102,7 @@ pub fn read_collisions(
                 path: table.path.clone(),
                 line: Some(row.line),
                 column: Some(names[j].clone()),
+                kind: DataFailure::Schema,
                 message: format!(
                     "required column is missing (needed for a sphere-sphere collision, d2_mm = {})",
                     table.shown(row, d2c)
@@ -180,6 +181,7 @@ pub fn read_collisions(
                 path: table.path.clone(),
                 line: Some(row.line),
                 column: Some("x1_m".into()),
+                kind: DataFailure::Value,
                 message: format!(
                     "{what} {} m apart, but touching needs {} m from the diameters (within {}%): positions must be in metres, at contact",
                     fmt_num(dist),
@@ -210,6 +212,7 @@ pub fn measure_records(
                 path: path.to_string(),
                 line: Some(r.line),
                 column: None,
+                kind: DataFailure::Value,
                 message,
             };
             let frame = r.pre.contact().map_err(|e| err(e.to_string()))?;

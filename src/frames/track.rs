@@ -126,6 +126,8 @@ impl std::fmt::Display for TrackError {
     }
 }
 
+impl std::error::Error for TrackError {}
+
 fn err(file: Option<&str>, message: impl Into<String>) -> TrackError {
     TrackError {
         file: file.map(str::to_string),

@@ -33,9 +33,15 @@ pub const LADDER: [u32; 3] = [4000, 8000, 16000];
 /// Why an export did not happen. Nothing is written in either case.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum ExportError {
-    /// A bad argument, file or combination: one line.
+    /// A bad argument or combination of arguments: one line.
     #[error("{0}")]
     Input(String),
+    /// An input document (params.json, walton.json) at fault: its name, and where it can be.
+    #[error(transparent)]
+    Data(#[from] super::super::DataError),
+    /// The engine could not be run for the round trip, or its output could not be read.
+    #[error("{0}")]
+    Engine(String),
     /// LAMMPS ran but its e differs from the toolkit's; `table` shows every collision.
     #[error("{message}")]
     Verify { message: String, table: String },
@@ -48,12 +54,6 @@ pub enum ExportError {
 impl From<String> for ExportError {
     fn from(s: String) -> Self {
         ExportError::Input(s)
-    }
-}
-
-impl From<super::super::DataError> for ExportError {
-    fn from(e: super::super::DataError) -> Self {
-        ExportError::Input(e.to_string())
     }
 }
 
@@ -403,7 +403,7 @@ pub fn export(law: &FittedLaw, o: &ExportOptions) -> Result<Exported, ExportErro
     }
     let verify_rows = match (&plan.lammps_files, o.verify) {
         (Some(lf), true) => {
-            let rows = run::verify_files(&tr, lf, &LADDER)?;
+            let rows = run::verify_files(&tr, lf, &LADDER).map_err(ExportError::Engine)?;
             let worst = rows
                 .iter()
                 .map(|r| r.difference().abs())

@@ -3,11 +3,30 @@
 //! and the files of `--out` (with one overlay figure per collision).
 
 use super::{collision_id, collisions_csv, detect_dir, detections_csv, spins_csv, tracks_csv};
-use crate::data::{ArgStyle, fmt_num};
+use crate::data::{ArgStyle, DataError, DataFailure, fmt_num};
 use crate::frames::detect::DetectSettings;
 use crate::frames::spin::Spin;
-use crate::frames::track::{CollisionResult, TrackSettings, assemble};
+use crate::frames::track::{CollisionResult, TrackError, TrackSettings, assemble};
 use std::path::PathBuf;
+
+/// Why a `track` run gave no result, by kind; each is one line.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum TrackJobError {
+    /// A bad argument: a frame rate, pixel size or diameter out of range, no or repeated
+    /// directories.
+    #[error("{0}")]
+    Input(String),
+    /// A directory or frame file at fault (missing, unreadable, not an image, mixed sizes).
+    #[error(transparent)]
+    Data(#[from] DataError),
+    /// The frames were read but a collision cannot be tracked (or, with `strict`, a bad frame).
+    #[error(transparent)]
+    Tracking(#[from] TrackError),
+    /// An overlay figure could not be drawn.
+    #[cfg(feature = "plot")]
+    #[error(transparent)]
+    Plot(#[from] crate::plot::PlotError),
+}
 
 /// Accepted frame rates, frames per second.
 pub const FPS_RANGE: (f64, f64) = (1e-6, 1e10);
@@ -107,22 +126,22 @@ pub fn track_dirs(
     dirs: &[PathBuf],
     request: &TrackRequest,
     on_frame: &(dyn Fn() + Sync),
-) -> Result<Vec<CollisionResult>, String> {
-    let (detect, settings) = request.settings()?;
+) -> Result<Vec<CollisionResult>, TrackJobError> {
+    let (detect, settings) = request.settings().map_err(TrackJobError::Input)?;
     if dirs.is_empty() {
-        return Err("no directory of frames given".into());
+        return Err(TrackJobError::Input("no directory of frames given".into()));
     }
     let mut results: Vec<CollisionResult> = Vec::new();
     for dir in dirs {
         let id = collision_id(dir);
         if results.iter().any(|r| r.id == id) {
-            return Err(format!(
+            return Err(TrackJobError::Input(format!(
                 "{}: collision id '{id}' is already used by another directory (the id is the directory's name)",
                 dir.display()
-            ));
+            )));
         }
-        let dets = detect_dir(dir, &detect, on_frame).map_err(|e| e.to_string())?;
-        results.push(assemble(&id, dets, &settings).map_err(|e| e.to_string())?);
+        let dets = detect_dir(dir, &detect, on_frame)?;
+        results.push(assemble(&id, dets, &settings)?);
     }
     Ok(results)
 }
@@ -153,7 +172,7 @@ pub fn warnings(results: &[CollisionResult]) -> Vec<String> {
 /// detections.csv, spins.csv, collisions.csv and overlay_<collision>.svg (the frame of closest
 /// approach with edge points, circles, centres and markers).
 #[cfg(feature = "plot")]
-pub fn track_files(results: &[CollisionResult]) -> Result<Vec<(String, Vec<u8>)>, String> {
+pub fn track_files(results: &[CollisionResult]) -> Result<Vec<(String, Vec<u8>)>, TrackJobError> {
     use crate::data::images::{encode_png, read_gray};
     use crate::data::readable;
     use crate::plot::frames::overlay_svg;
@@ -177,8 +196,14 @@ pub fn track_files(results: &[CollisionResult]) -> Result<Vec<(String, Vec<u8>)>
             _ => closest(r),
         };
         let f = &r.frames[r.track_frames[row]];
-        let img = read_gray(std::path::Path::new(&f.meta.name)).map_err(|e| e.to_string())?;
-        let png = encode_png(&img)?;
+        let img = read_gray(std::path::Path::new(&f.meta.name))?;
+        let png = encode_png(&img).map_err(|message| DataError {
+            path: f.meta.name.clone(),
+            line: None,
+            column: None,
+            kind: DataFailure::Format,
+            message,
+        })?;
         let title = format!(
             "{}: frame {} (t = {} s)",
             r.id,
