@@ -169,7 +169,7 @@ pub fn warnings(results: &[CollisionResult]) -> Vec<String> {
 }
 
 /// The files of `track --out`: tracks.csv (the `kinematics` schema, with spins),
-/// detections.csv, spins.csv, collisions.csv and overlay_<collision>.svg (the frame of closest
+/// detections.csv, spins.csv, collisions.csv and `overlay_<collision>.svg` (the frame of closest
 /// approach with edge points, circles, centres and markers).
 #[cfg(feature = "plot")]
 pub fn track_files(results: &[CollisionResult]) -> Result<Vec<(String, Vec<u8>)>, TrackJobError> {
