@@ -7,18 +7,18 @@ cd "$(dirname "$0")/.."
 cargo build --release --quiet
 B=target/release/restitution
 
-# Fit (issue 3): Fig. 7-like data, then the fit of all models.
+# Fit: Fig. 7-like data, then the fit of all models.
 cargo run --release --quiet --example gen_fig7_data
 $B fit data/fig7_nylon.csv --material nylon --out reports/fit > /dev/null
 
-# Walton (issue 5): synthetic oblique collisions like Fig. 6, then the hinge fit.
+# Walton: synthetic oblique collisions like Fig. 6, then the hinge fit.
 cargo run --release --quiet --example gen_oblique_collisions
 $B walton fit data/oblique_collisions.csv --material nylon --out reports/walton > /dev/null
 # Coverage and scatter of the Walton fit over 1000 seeded repetitions, both weightings (about 10 s;
 # the ms-per-fit lines are timings and vary).
 cargo run --release --quiet --example walton_coverage -- 1000 1000 60 > reports/walton/coverage.txt
 
-# Kinematics (issue 6): two virtual experiments through the whole chain, and the camera study.
+# Kinematics: two virtual experiments through the whole chain, and the camera study.
 $B simulate --material nylon --out data/virtual/normal --n 150 --seed 1 --d-mm 12.7 \
     --v-n-m-s 0.5,25 --incidence-deg 0,30 --model product --eta 190 --sigma-y-pa 4e7 > /dev/null
 $B kinematics data/virtual/normal/tracks.csv --material nylon --fixed-gravity \
@@ -39,7 +39,7 @@ bash scripts/chain_coverage.sh > /dev/null
 cargo run --release --quiet --example track_demo -- target/frames > /dev/null
 $B track target/frames/shot_7 --fps 1000 --d-mm 12.7 --out reports/track > /dev/null
 
-# Bench (issue 4): work-precision chart, stability map, fit accuracy, targets (timings vary by machine).
+# Bench: work-precision chart, stability map, fit accuracy, targets (timings vary by machine).
 $B bench --out reports/bench > /dev/null
 
 # Export (DEM): the shipped fits as engine inputs. With lmp (LAMMPS) on PATH the LAMMPS exports
@@ -59,5 +59,5 @@ $B export --engine lammps --material nylon --d-mm 6.35,25.4 --wall --eta 2000 --
 $B export reports/fit/params.json --engine table --v-range 0.5,40 --walton reports/walton/walton.json \
     --out reports/export/table > reports/export/table/report.txt
 cargo run --release --quiet --example tsuji_accuracy > reports/export/tsuji_accuracy.txt
-# Frames (issue "Frames", item 6): accuracy of the frame pipeline on rendered frames (10-15 min on 2 cores).
+# Frames: accuracy of the frame pipeline on rendered frames (10-15 min on 2 cores).
 cargo run --release --quiet --example frames_accuracy > /dev/null

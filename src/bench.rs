@@ -40,7 +40,7 @@ use std::time::Duration;
 pub use timing::TimingPlan;
 pub use work_precision::{WpPoint, WpRow, fit_order};
 
-/// The chart's kappa range (the representative set).
+/// The chart's kappa range (a representative set: kappa 1e-4..5).
 pub const CHART_KAPPA_MIN: f64 = 1e-4;
 pub const CHART_KAPPA_MAX: f64 = 5.0;
 /// The chart's largest u (the plastic fixture goes on to f64::MAX for the stability map).
@@ -268,7 +268,7 @@ pub fn chart_vm_points() -> Vec<VmRef> {
         .collect()
 }
 
-/// A candidate default ODE setting, checked against the bar over kappa in [1e-8, 100].
+/// A candidate default ODE setting, checked against the default's accuracy target over kappa in [1e-8, 100].
 #[derive(Debug, Clone, PartialEq)]
 pub struct OdeCandidate {
     pub spec: VmSpec,
@@ -284,7 +284,7 @@ pub struct OdeCandidate {
 }
 
 impl OdeCandidate {
-    /// The bar for the default: |error in e| <= 1e-10, relative error of 1 - e <= 1e-8.
+    /// The accuracy target for the default (README, "Speed against accuracy"): |error in e| <= 1e-10, relative error of 1 - e <= 1e-8.
     pub fn meets_bar(&self) -> bool {
         self.failed == 0 && self.max_abs_e <= 1e-10 && self.max_rel_one_minus_e <= 1e-8
     }
@@ -428,7 +428,7 @@ pub fn run(cfg: &BenchConfig, fit_data: Option<&FitData>) -> Result<BenchReport>
     })
 }
 
-/// Cheaper settings than the default, each checked against the bar for the default over
+/// Cheaper settings than the default, each checked against the default's accuracy target over
 /// the fixture and the dense kappa grid up to 100, both rules.
 pub fn ode_candidates(
     kappas: &[f64],

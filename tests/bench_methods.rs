@@ -197,7 +197,7 @@ fn approximation_bounds_hold_at_every_reference_point() {
 fn plastic_methods_hold_their_accuracy() {
     let refs = pm_fixture();
     let at = |u: f64| *refs.iter().find(|r| r.u == u).expect("fixture u");
-    // Closed form: e within 4 ulp (the issue's target; measured 1.2 ulp over the fixture).
+    // Closed form: e within 4 ulp (the target; measured 1.2 ulp over the fixture).
     let r = at(10.0);
     let got = PmSpec::ClosedForm.eval(r.u).unwrap();
     assert!(((got.e - r.e) / r.e).abs() <= 4.0 * f64::EPSILON);
@@ -422,7 +422,7 @@ fn csv_outputs_have_the_required_columns() {
 #[test]
 fn cli_quick_run_writes_every_file_or_none() {
     // The documented command at --quick (about a second on the dev box): all nine files appear,
-    // with the columns the issue asks for; a bad --out is one line on stderr, exit 1, no files.
+    // with the documented columns; a bad --out is one line on stderr, exit 1, no files.
     let dir = std::env::temp_dir().join(format!("restitution-bench-test-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let out = std::process::Command::new(env!("CARGO_BIN_EXE_restitution"))

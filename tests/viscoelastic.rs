@@ -40,7 +40,7 @@ fn reference() -> Vec<Ref> {
         .collect()
 }
 
-/// The issue's accuracy bar: |error in e| <= 1e-10 and relative error of 1 - e <= 1e-8.
+/// The accuracy bar of the default ODE (README, "Accuracy"): |error in e| <= 1e-10 and relative error of 1 - e <= 1e-8.
 fn assert_bar(label: &str, r: &Ref, e: f64, one_minus_e: f64) {
     let abs = (e - r.e).abs();
     let rel = ((one_minus_e - r.one_minus_e) / r.one_minus_e).abs();
@@ -97,7 +97,7 @@ fn default_ode_meets_the_accuracy_bar_everywhere() {
 
 #[test]
 fn master_curve_error_is_below_1e_12() {
-    // The table's own bound (issue: max error in e <= 1e-12), checked here against the
+    // The table's own bound (target: max error in e <= 1e-12), checked here against the
     // independent reference rather than the ODE it was built from; relative error of 1 - e
     // at the same level (1e-11 allows for 1 - e ~ 1e-8 where one ulp of e is 1e-8 relative).
     for r in reference() {

@@ -58,7 +58,7 @@ fn shipped_data_fit_covers_the_planted_values() {
     ]);
     assert!(ok, "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
-    // The JSON shape of the issue: {"e": {"value", "stderr"}, "beta0": {...}, "mu0": {...}, "n"}.
+    // The JSON shape the README documents: {"e": {"value", "stderr"}, "beta0": {...}, "mu0": {...}, "n"}.
     for key in ["e", "beta0", "mu0"] {
         assert!(v[key]["value"].is_f64(), "{key}");
         assert!(v[key]["stderr"].is_f64(), "{key}");

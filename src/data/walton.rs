@@ -30,7 +30,7 @@ fn sphere_columns(i: u8) -> [String; 15] {
     ]
 }
 
-/// Indices into [`sphere_columns`] that are required (the in-plane set of the issue); the others
+/// Indices into [`sphere_columns`] that are required (the in-plane set: positions, velocities and z spins); the others
 /// (z, v_z, w_x, w_y) are optional and default to 0.
 const REQUIRED: [usize; 8] = [0, 1, 3, 4, 8, 9, 10, 14];
 
@@ -286,7 +286,7 @@ pub fn write_collisions(records: &[CollisionRecord]) -> String {
     }
     header.push("d1_mm".into());
     header.push("d2_mm".into());
-    // The issue's order: positions (sphere 1, sphere 2), motion before (1, 2), after (1, 2).
+    // The schema's order: positions (sphere 1, sphere 2), motion before (1, 2), after (1, 2).
     let groups: [(bool, std::ops::Range<usize>); 6] = [
         (true, 0..3),
         (false, 0..3),
