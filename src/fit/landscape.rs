@@ -24,6 +24,7 @@
 
 use super::bnb::{Bound, Landscape};
 use super::objective::Objective;
+use super::sums;
 
 mod powerlaw;
 pub use powerlaw::PowerLaw;
@@ -60,30 +61,39 @@ impl<'a> Separable<'a> {
         &self.rows[k][r * self.n..(r + 1) * self.n]
     }
 
-    fn bound_with(&self, c: impl Fn(f64, f64) -> f64, lo: [usize; 2], hi: [usize; 2]) -> Bound {
+    fn bound_with(
+        &self,
+        c: impl Fn(f64, f64) -> f64 + Sync,
+        lo: [usize; 2],
+        hi: [usize; 2],
+    ) -> Bound {
         let (f0, f1) = (self.row(0, lo[0]), self.row(0, hi[0]));
         let (g0, g1) = (self.row(1, lo[1]), self.row(1, hi[1]));
-        let (mut lb, mut l0, mut l1) = (0.0, 0.0, 0.0);
-        for i in 0..self.n {
-            // F falls along axis 0, G rises along axis 1: the extremes are opposite corners.
-            let top = c(f0[i], g1[i]);
-            let bottom = c(f1[i], g0[i]) - self.slack;
-            let e = self.e[i];
-            let d = if e < bottom {
-                bottom - e
-            } else if e > top + self.slack {
-                e - top - self.slack
-            } else {
-                0.0
-            };
-            let w = self.w[i];
-            lb += w * d * d;
-            let r = (top - e).abs();
-            let d0 = top - c(f1[i], g1[i]);
-            let d1 = top - c(f0[i], g0[i]);
-            l0 += w * d0 * (r + d0);
-            l1 += w * d1 * (r + d1);
-        }
+        let (e, w, slack) = (&self.e[..], &self.w[..], self.slack);
+        let [lb, l0, l1] = sums::sum(self.n, |points| {
+            let (mut lb, mut l0, mut l1) = (0.0, 0.0, 0.0);
+            for i in points {
+                // F falls along axis 0, G rises along axis 1: the extremes are opposite corners.
+                let top = c(f0[i], g1[i]);
+                let bottom = c(f1[i], g0[i]) - slack;
+                let ei = e[i];
+                let d = if ei < bottom {
+                    bottom - ei
+                } else if ei > top + slack {
+                    ei - top - slack
+                } else {
+                    0.0
+                };
+                let wi = w[i];
+                lb += wi * d * d;
+                let r = (top - ei).abs();
+                let d0 = top - c(f1[i], g1[i]);
+                let d1 = top - c(f0[i], g0[i]);
+                l0 += wi * d0 * (r + d0);
+                l1 += wi * d1 * (r + d1);
+            }
+            [lb, l0, l1]
+        });
         Bound {
             lb,
             loose: [l0, l1],
@@ -94,54 +104,54 @@ impl<'a> Separable<'a> {
 impl Landscape for Separable<'_> {
     fn add_row(&mut self, axis: usize, t: f64) -> Result<(), String> {
         let (n, ev) = (self.n, self.obj.ev);
-        let mut failure = None;
         let start = self.rows[axis].len();
         self.rows[axis].resize(start + n, 1.0);
-        if self.active[axis] {
-            self.obj.evals.set(self.obj.evals.get() + 1);
-            let x = t.exp();
-            if axis == 1 {
-                ev.e_pm_row(x, &mut self.rows[1][start..start + n]);
-            }
-            for i in 0..n {
-                let v = if axis == 0 {
-                    match ev.e_vm(i, x) {
-                        Ok(v) => v,
-                        Err(e) => {
-                            failure.get_or_insert(format!("e_vm at eta = {x}: {e}"));
-                            f64::NAN
-                        }
-                    }
-                } else {
-                    self.rows[1][start + i]
-                };
-                if v.is_nan() && failure.is_none() {
-                    failure = Some(format!(
-                        "the model is NaN at {} = {x} for {}",
-                        if axis == 0 { "eta" } else { "sigma_y" },
-                        self.obj.describe_point(i)
-                    ));
-                }
-                self.rows[axis][start + i] = v;
-            }
+        if !self.active[axis] {
+            return Ok(());
         }
-        failure.map_or(Ok(()), Err)
+        self.obj.evals.set(self.obj.evals.get() + 1);
+        let x = t.exp();
+        let row = &mut self.rows[axis][start..start + n];
+        if axis == 1 {
+            ev.e_pm_row(x, row);
+        } else {
+            sums::fill(row, |i| ev.e_vm(i, x).unwrap_or(f64::NAN));
+        }
+        // The first point that failed names the failure (the evaluation's error if it gave
+        // one, else the NaN).
+        let Some(i) = row.iter().position(|v| v.is_nan()) else {
+            return Ok(());
+        };
+        let error = if axis == 0 { ev.e_vm(i, x).err() } else { None };
+        Err(match error {
+            Some(e) => format!("e_vm at eta = {x}: {e}"),
+            None => format!(
+                "the model is NaN at {} = {x} for {}",
+                if axis == 0 { "eta" } else { "sigma_y" },
+                self.obj.describe_point(i)
+            ),
+        })
     }
 
     fn node(&self, r: [usize; 2]) -> f64 {
         let (f, g) = (self.row(0, r[0]), self.row(1, r[1]));
-        let mut s = 0.0;
-        if self.min_rule {
-            for i in 0..self.n {
-                let d = f[i].min(g[i]) - self.e[i];
-                s += self.w[i] * d * d;
+        let (e, w) = (&self.e[..], &self.w[..]);
+        let min_rule = self.min_rule;
+        let [s] = sums::sum(self.n, |points| {
+            let mut s = 0.0;
+            if min_rule {
+                for i in points {
+                    let d = f[i].min(g[i]) - e[i];
+                    s += w[i] * d * d;
+                }
+            } else {
+                for i in points {
+                    let d = f[i] * g[i] - e[i];
+                    s += w[i] * d * d;
+                }
             }
-        } else {
-            for i in 0..self.n {
-                let d = f[i] * g[i] - self.e[i];
-                s += self.w[i] * d * d;
-            }
-        }
+            [s]
+        });
         s
     }
 

@@ -4,6 +4,7 @@
 use super::super::bnb::{Bound, Landscape};
 use super::super::models::{POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S, powerlaw_d_mm};
 use super::super::objective::Objective;
+use super::super::sums;
 
 /// Relative widening of the z ranges of the power law: a few rounding errors of exp and a
 /// product (1e-12 is 4500 ulp).
@@ -92,13 +93,17 @@ impl PowerLaw {
         let (a, b) = (self.t[0][r[0]], self.t[1][r[1]]);
         // Least squares in A_c with z and w scaled by their maxima (no overflow in the sums).
         let zmax = (0..self.n).map(|i| za[i] * zb[i]).fold(0.0, f64::max);
-        let (mut num, mut den) = (0.0, 0.0);
-        for i in 0..self.n {
-            let z = za[i] * zb[i] / zmax;
-            let w = self.w_scaled[i];
-            num += w * z * self.y[i];
-            den += w * z * z;
-        }
+        let (y, ws) = (&self.y[..], &self.w_scaled[..]);
+        let [num, den] = sums::sum(self.n, |points| {
+            let (mut num, mut den) = (0.0, 0.0);
+            for i in points {
+                let z = za[i] * zb[i] / zmax;
+                let w = ws[i];
+                num += w * z * y[i];
+                den += w * z * z;
+            }
+            [num, den]
+        });
         let s = self.shift(a, b);
         let (lo, hi) = (self.a_range.0 * s.exp(), self.a_range.1 * s.exp());
         let ac = num / den / zmax;
@@ -109,31 +114,39 @@ impl PowerLaw {
         } else {
             ac
         };
-        let mut chi2 = 0.0;
-        for i in 0..self.n {
-            let d = ac * za[i] * zb[i] - self.y[i];
-            chi2 += self.w[i] * d * d;
-        }
+        let w = &self.w[..];
+        let [chi2] = sums::sum(self.n, |points| {
+            let mut chi2 = 0.0;
+            for i in points {
+                let d = ac * za[i] * zb[i] - y[i];
+                chi2 += w[i] * d * d;
+            }
+            [chi2]
+        });
         (ac.ln() - s, chi2)
     }
 
     /// f(A), f'(A) and f''(A) (from the right) of the module doc. Branch-free (selects), so it
     /// vectorises; every input is finite (rows are checked when they are made).
     fn f_slope_curv(&self, zlo: &[f64], zhi: &[f64], a: f64) -> (f64, f64, f64) {
-        let (mut f, mut d, mut h) = (0.0, 0.0, 0.0);
-        for i in 0..self.n {
-            let w = self.w[i];
-            let u = a * zlo[i] - self.y[i];
-            let v = self.y[i] - a * zhi[i];
-            // At most one of u, v is positive (zlo <= zhi).
-            let pu = if u > 0.0 { u } else { 0.0 };
-            let pv = if v > 0.0 { v } else { 0.0 };
-            let cu = if u > 0.0 { zlo[i] } else { 0.0 };
-            let cv = if v > 0.0 { zhi[i] } else { 0.0 };
-            f += w * (pu * pu + pv * pv);
-            d += 2.0 * w * (zlo[i] * pu - zhi[i] * pv);
-            h += 2.0 * w * (cu * cu + cv * cv);
-        }
+        let (y, w) = (&self.y[..], &self.w[..]);
+        let [f, d, h] = sums::sum(self.n, |points| {
+            let (mut f, mut d, mut h) = (0.0, 0.0, 0.0);
+            for i in points {
+                let w = w[i];
+                let u = a * zlo[i] - y[i];
+                let v = y[i] - a * zhi[i];
+                // At most one of u, v is positive (zlo <= zhi).
+                let pu = if u > 0.0 { u } else { 0.0 };
+                let pv = if v > 0.0 { v } else { 0.0 };
+                let cu = if u > 0.0 { zlo[i] } else { 0.0 };
+                let cv = if v > 0.0 { zhi[i] } else { 0.0 };
+                f += w * (pu * pu + pv * pv);
+                d += 2.0 * w * (zlo[i] * pu - zhi[i] * pv);
+                h += 2.0 * w * (cu * cu + cv * cv);
+            }
+            [f, d, h]
+        });
         (f, d, h)
     }
 }
@@ -142,7 +155,8 @@ impl Landscape for PowerLaw {
     fn add_row(&mut self, axis: usize, t: f64) -> Result<(), String> {
         let c = if axis == 0 { &self.c1 } else { &self.c2 };
         let sign = if axis == 0 { -1.0 } else { 1.0 };
-        let row: Vec<f64> = c.iter().map(|x| (sign * t * x).exp()).collect();
+        let mut row = vec![0.0; self.n];
+        sums::fill(&mut row, |i| (sign * t * c[i]).exp());
         let bad = row.iter().any(|z| !z.is_finite());
         self.rows[axis].extend(row);
         self.t[axis].push(t);
@@ -162,12 +176,14 @@ impl Landscape for PowerLaw {
     fn bound(&self, lo: [usize; 2], hi: [usize; 2], target: f64) -> Bound {
         let (za0, za1) = (self.row(0, lo[0]), self.row(0, hi[0]));
         let (zb0, zb1) = (self.row(1, lo[1]), self.row(1, hi[1]));
-        let mut zlo = Vec::with_capacity(self.n);
-        let mut zhi = Vec::with_capacity(self.n);
-        for i in 0..self.n {
-            zlo.push(za0[i].min(za1[i]) * zb0[i].min(zb1[i]) * (1.0 - Z_SLACK));
-            zhi.push(za0[i].max(za1[i]) * zb0[i].max(zb1[i]) * (1.0 + Z_SLACK));
-        }
+        let mut zlo = vec![0.0; self.n];
+        let mut zhi = vec![0.0; self.n];
+        sums::fill(&mut zlo, |i| {
+            za0[i].min(za1[i]) * zb0[i].min(zb1[i]) * (1.0 - Z_SLACK)
+        });
+        sums::fill(&mut zhi, |i| {
+            za0[i].max(za1[i]) * zb0[i].max(zb1[i]) * (1.0 + Z_SLACK)
+        });
         // The box of the centred amplitude over the cell: the shift is linear in a and b.
         let (a0, a1) = (self.t[0][lo[0]], self.t[0][hi[0]]);
         let (b0, b1) = (self.t[1][lo[1]], self.t[1][hi[1]]);
@@ -201,12 +217,17 @@ impl Landscape for PowerLaw {
         // f'(x1) < 0 < f'(x2): the tangents' crossing is a lower bound. Newton steps on the
         // piecewise linear f' (exact on each piece) move the bracket in; bisection (geometric, A
         // spans decades) when a step leaves it. Start from the least-squares A at the middle z.
-        let (mut num, mut den) = (0.0, 0.0);
-        for i in 0..self.n {
-            let z = 0.5 * (zlo[i] + zhi[i]);
-            num += self.w[i] * z * self.y[i];
-            den += self.w[i] * z * z;
-        }
+        let (y, w) = (&self.y[..], &self.w[..]);
+        let (zl, zh) = (&zlo[..], &zhi[..]);
+        let [num, den] = sums::sum(self.n, |points| {
+            let (mut num, mut den) = (0.0, 0.0);
+            for i in points {
+                let z = 0.5 * (zl[i] + zh[i]);
+                num += w[i] * z * y[i];
+                den += w[i] * z * z;
+            }
+            [num, den]
+        });
         let mut x = num / den;
         let mut lb = f64::NEG_INFINITY;
         for _ in 0..POWERLAW_BOUND_ITERS {
