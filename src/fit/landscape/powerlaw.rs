@@ -5,6 +5,7 @@ use super::super::bnb::{Bound, Landscape};
 use super::super::models::{POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S, powerlaw_d_mm};
 use super::super::objective::Objective;
 use super::super::sums;
+use std::cell::RefCell;
 
 /// Relative widening of the z ranges of the power law: a few rounding errors of exp and a
 /// product (1e-12 is 4500 ulp).
@@ -32,6 +33,9 @@ pub struct PowerLaw {
     sens: [f64; 2],
     /// How close to its minimum a cell bound is computed (efficiency only: any stop is valid).
     pub bound_tol: f64,
+    /// The z ranges of the last cell bound, kept so that each bound does not allocate (and, for
+    /// large data, fault in) two fresh arrays of the points.
+    scratch: RefCell<(Vec<f64>, Vec<f64>)>,
 }
 
 impl PowerLaw {
@@ -75,6 +79,7 @@ impl PowerLaw {
             rows: [Vec::new(), Vec::new()],
             t: [Vec::new(), Vec::new()],
             bound_tol: 0.0,
+            scratch: RefCell::new((vec![0.0; n], vec![0.0; n])),
         }
     }
 
@@ -176,12 +181,12 @@ impl Landscape for PowerLaw {
     fn bound(&self, lo: [usize; 2], hi: [usize; 2], target: f64) -> Bound {
         let (za0, za1) = (self.row(0, lo[0]), self.row(0, hi[0]));
         let (zb0, zb1) = (self.row(1, lo[1]), self.row(1, hi[1]));
-        let mut zlo = vec![0.0; self.n];
-        let mut zhi = vec![0.0; self.n];
-        sums::fill(&mut zlo, |i| {
+        let mut scratch = self.scratch.borrow_mut();
+        let (zlo, zhi) = &mut *scratch;
+        sums::fill(zlo, |i| {
             za0[i].min(za1[i]) * zb0[i].min(zb1[i]) * (1.0 - Z_SLACK)
         });
-        sums::fill(&mut zhi, |i| {
+        sums::fill(zhi, |i| {
             za0[i].max(za1[i]) * zb0[i].max(zb1[i]) * (1.0 + Z_SLACK)
         });
         // The box of the centred amplitude over the cell: the shift is linear in a and b.
@@ -200,14 +205,14 @@ impl Landscape for PowerLaw {
         let wa = (a1 - a0) * self.sens[0];
         let wb = (b1 - b0) * self.sens[1];
         let loose = |_: f64| [wa * wa, wb * wb];
-        let (mut f1, mut d1, _) = self.f_slope_curv(&zlo, &zhi, x1);
+        let (mut f1, mut d1, _) = self.f_slope_curv(zlo, zhi, x1);
         if d1 >= 0.0 {
             return Bound {
                 lb: f1,
                 loose: loose(x1),
             };
         }
-        let (mut f2, mut d2, _) = self.f_slope_curv(&zlo, &zhi, x2);
+        let (mut f2, mut d2, _) = self.f_slope_curv(zlo, zhi, x2);
         if d2 <= 0.0 {
             return Bound {
                 lb: f2,
@@ -238,7 +243,7 @@ impl Landscape for PowerLaw {
                     0.5 * (x1 + x2)
                 };
             }
-            let (f, d, h) = self.f_slope_curv(&zlo, &zhi, x);
+            let (f, d, h) = self.f_slope_curv(zlo, zhi, x);
             if d == 0.0 || f == 0.0 {
                 lb = f;
                 break;
