@@ -249,8 +249,11 @@ mod tests {
     /// Every bound must lie below chi2 at every point of its cell: checked on a 9 x 9 sample of
     /// each of a set of cells, chi2 computed directly from the model (not from the rows).
     fn check_bounds(kind: ModelKind, cells: &[([f64; 2], [f64; 2])]) {
-        let d = data();
-        let ev = Evaluator::new(&d, ContactEnd::Overlap, VmMethod::Master);
+        check_bounds_on(&data(), kind, cells);
+    }
+
+    fn check_bounds_on(d: &FitData, kind: ModelKind, cells: &[([f64; 2], [f64; 2])]) {
+        let ev = Evaluator::new(d, ContactEnd::Overlap, VmMethod::Master);
         let obj = Objective::new(&ev, kind).unwrap();
         for &(lo, hi) in cells {
             let direct = |t: [f64; 2]| -> f64 {
@@ -301,6 +304,39 @@ mod tests {
             );
             assert!(bound >= 0.0 && bound.is_finite());
         }
+    }
+
+    #[test]
+    fn large_data_bounds_are_below_chi2_everywhere_in_their_cells() {
+        // Above the parallel threshold the sums are chunked and the power law's bound starts
+        // from inside its box (powerlaw.rs): the same check on the 40-point pattern repeated
+        // with every speed moved (distinct points), a few cells per kind.
+        let base = data();
+        let n = crate::fit::sums::PARALLEL_MIN_POINTS + 1000;
+        let obs = (0..n)
+            .map(|k| {
+                let mut o = base.obs[k % base.obs.len()];
+                o.v_n_m_s *= 1.0 + 1e-3 * ((k * 7919 % 2001) as f64 / 1000.0 - 1.0);
+                o
+            })
+            .collect();
+        let d = FitData::new(base.material, obs).unwrap();
+        assert!(crate::fit::sums::is_large(d.len()), "{} points", d.len());
+        let (e, s) = (190f64.ln(), 4e7f64.ln());
+        check_bounds_on(
+            &d,
+            ModelKind::Min,
+            &[([e - 0.01, s - 0.01], [e + 0.02, s + 0.005])],
+        );
+        check_bounds_on(
+            &d,
+            ModelKind::PowerLaw,
+            &[
+                ([0.3, 0.1], [0.7, 0.5]),
+                ([-3.0, 2.0], [1.0, 4.0]),
+                ([0.49, 0.29], [0.51, 0.31]),
+            ],
+        );
     }
 
     #[test]
