@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
-# CPU time of `fit` on 100 000 rows, per model: the Fig. 7 data repeated (rows that share a pair
-# geometry and a speed, merged exactly by the fit), and the same rows with every speed moved by
-# up to 0.1% (100 000 distinct points: the certified search's cost grows with them). Quoted in
-# the README (fuzzing; known limitations). The distinct-speed powerlaw fit takes about 40 s.
+# CPU and wall time of `fit` on 100 000 rows, per model: the Fig. 7 data repeated (rows that
+# share a pair geometry and a speed, merged exactly by the fit), and the same rows with every
+# speed moved by up to 0.1% (100 000 distinct points: the certified search's cost grows with
+# them; above 16384 points its sums run on both cores, so wall time depends on the machine's
+# load). Quoted in the README (fuzzing; known limitations). The distinct-speed powerlaw fit
+# takes about 40 s.
 #
 # Usage: bash scripts/time_big_fit.sh [BINARY]   (default target/release/restitution)
 set -euo pipefail
@@ -29,7 +31,7 @@ with open(f"{d}/repeated.csv", "w") as a, open(f"{d}/distinct.csv", "w") as b:
 PY
 for data in repeated distinct; do
     for m in vm pm min product powerlaw; do
-        /usr/bin/time -f "$data $m: %U s user + %S s system" \
+        /usr/bin/time -f "$data $m: %U s user + %S s system, %e s wall" \
             "$BIN" fit "$dir/$data.csv" --material nylon --model "$m" > /dev/null 2> "$dir/err" || true
         tail -1 "$dir/err"
     done

@@ -17,6 +17,7 @@ pub mod profile;
 pub mod result;
 pub mod scalar;
 pub mod search;
+pub mod sums;
 pub mod walton;
 
 pub use compare::{Comparison, ComparisonRow, compare};

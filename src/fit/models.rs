@@ -297,9 +297,8 @@ impl<'a> Evaluator<'a> {
     /// e_pm of every point at sigma_y, into `out`.
     pub fn e_pm_row(&self, sigma_y_pa: f64, out: &mut [f64]) {
         let s25 = sigma_y_pa.powf(2.5);
-        for (i, o) in out.iter_mut().enumerate().take(self.len()) {
-            *o = self.e_pm_s25(i, s25);
-        }
+        let n = self.len().min(out.len());
+        super::sums::fill(&mut out[..n], |i| self.e_pm_s25(i, s25));
     }
 
     /// Model e at every point for physical parameters `p` (order of [`ModelKind::params`]).

@@ -4,6 +4,8 @@
 use super::super::bnb::{Bound, Landscape};
 use super::super::models::{POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S, powerlaw_d_mm};
 use super::super::objective::Objective;
+use super::super::sums;
+use std::cell::RefCell;
 
 /// Relative widening of the z ranges of the power law: a few rounding errors of exp and a
 /// product (1e-12 is 4500 ulp).
@@ -31,6 +33,9 @@ pub struct PowerLaw {
     sens: [f64; 2],
     /// How close to its minimum a cell bound is computed (efficiency only: any stop is valid).
     pub bound_tol: f64,
+    /// The z ranges of the last cell bound, kept so that each bound does not allocate (and, for
+    /// large data, fault in) two fresh arrays of the points.
+    scratch: RefCell<(Vec<f64>, Vec<f64>)>,
 }
 
 impl PowerLaw {
@@ -74,6 +79,7 @@ impl PowerLaw {
             rows: [Vec::new(), Vec::new()],
             t: [Vec::new(), Vec::new()],
             bound_tol: 0.0,
+            scratch: RefCell::new((vec![0.0; n], vec![0.0; n])),
         }
     }
 
@@ -92,13 +98,17 @@ impl PowerLaw {
         let (a, b) = (self.t[0][r[0]], self.t[1][r[1]]);
         // Least squares in A_c with z and w scaled by their maxima (no overflow in the sums).
         let zmax = (0..self.n).map(|i| za[i] * zb[i]).fold(0.0, f64::max);
-        let (mut num, mut den) = (0.0, 0.0);
-        for i in 0..self.n {
-            let z = za[i] * zb[i] / zmax;
-            let w = self.w_scaled[i];
-            num += w * z * self.y[i];
-            den += w * z * z;
-        }
+        let (y, ws) = (&self.y[..], &self.w_scaled[..]);
+        let [num, den] = sums::sum(self.n, |points| {
+            let (mut num, mut den) = (0.0, 0.0);
+            for i in points {
+                let z = za[i] * zb[i] / zmax;
+                let w = ws[i];
+                num += w * z * y[i];
+                den += w * z * z;
+            }
+            [num, den]
+        });
         let s = self.shift(a, b);
         let (lo, hi) = (self.a_range.0 * s.exp(), self.a_range.1 * s.exp());
         let ac = num / den / zmax;
@@ -109,32 +119,112 @@ impl PowerLaw {
         } else {
             ac
         };
-        let mut chi2 = 0.0;
-        for i in 0..self.n {
-            let d = ac * za[i] * zb[i] - self.y[i];
-            chi2 += self.w[i] * d * d;
-        }
+        let w = &self.w[..];
+        let [chi2] = sums::sum(self.n, |points| {
+            let mut chi2 = 0.0;
+            for i in points {
+                let d = ac * za[i] * zb[i] - y[i];
+                chi2 += w[i] * d * d;
+            }
+            [chi2]
+        });
         (ac.ln() - s, chi2)
     }
 
     /// f(A), f'(A) and f''(A) (from the right) of the module doc. Branch-free (selects), so it
     /// vectorises; every input is finite (rows are checked when they are made).
     fn f_slope_curv(&self, zlo: &[f64], zhi: &[f64], a: f64) -> (f64, f64, f64) {
-        let (mut f, mut d, mut h) = (0.0, 0.0, 0.0);
-        for i in 0..self.n {
-            let w = self.w[i];
-            let u = a * zlo[i] - self.y[i];
-            let v = self.y[i] - a * zhi[i];
-            // At most one of u, v is positive (zlo <= zhi).
-            let pu = if u > 0.0 { u } else { 0.0 };
-            let pv = if v > 0.0 { v } else { 0.0 };
-            let cu = if u > 0.0 { zlo[i] } else { 0.0 };
-            let cv = if v > 0.0 { zhi[i] } else { 0.0 };
-            f += w * (pu * pu + pv * pv);
-            d += 2.0 * w * (zlo[i] * pu - zhi[i] * pv);
-            h += 2.0 * w * (cu * cu + cv * cv);
-        }
+        let (y, w) = (&self.y[..], &self.w[..]);
+        let [f, d, h] = sums::sum(self.n, |points| {
+            let (mut f, mut d, mut h) = (0.0, 0.0, 0.0);
+            for i in points {
+                let w = w[i];
+                let u = a * zlo[i] - y[i];
+                let v = y[i] - a * zhi[i];
+                // At most one of u, v is positive (zlo <= zhi).
+                let pu = if u > 0.0 { u } else { 0.0 };
+                let pv = if v > 0.0 { v } else { 0.0 };
+                let cu = if u > 0.0 { zlo[i] } else { 0.0 };
+                let cv = if v > 0.0 { zhi[i] } else { 0.0 };
+                f += w * (pu * pu + pv * pv);
+                d += 2.0 * w * (zlo[i] * pu - zhi[i] * pv);
+                h += 2.0 * w * (cu * cu + cv * cv);
+            }
+            [f, d, h]
+        });
         (f, d, h)
+    }
+}
+
+impl PowerLaw {
+    /// The minimum of f over the box of A, bounded below as in [`Landscape::bound`] for small
+    /// data, but starting from the least-squares A at the middle z and evaluating the box's ends
+    /// only when a step leaves the bracket: near the minimum (where nearly all cells are) the
+    /// two evaluations at the ends of a box of decades were a third of the work. Any two
+    /// tangents with slopes of opposite signs cross below the minimum of the convex f; a slope
+    /// of the wrong sign at a box end puts the minimum over the box there. Without both kinds of
+    /// tangent after the iterations, -inf (no bound: the cell is split).
+    fn bound_from_inside(&self, zlo: &[f64], zhi: &[f64], ends: (f64, f64), target: f64) -> f64 {
+        let (y, w) = (&self.y[..], &self.w[..]);
+        let [num, den] = sums::sum(self.n, |points| {
+            let (mut num, mut den) = (0.0, 0.0);
+            for i in points {
+                let z = 0.5 * (zlo[i] + zhi[i]);
+                num += w[i] * z * y[i];
+                den += w[i] * z * z;
+            }
+            [num, den]
+        });
+        let mut x = num / den;
+        // The latest points with f' < 0 (left of the minimum) and f' > 0 (right of it).
+        let mut left: Option<(f64, f64, f64)> = None;
+        let mut right: Option<(f64, f64, f64)> = None;
+        let mut lb = f64::NEG_INFINITY;
+        for _ in 0..POWERLAW_BOUND_ITERS {
+            let l = left.map_or(ends.0, |p| p.0);
+            let r = right.map_or(ends.1, |p| p.0);
+            if !(x > l && x < r) {
+                x = if x <= l && left.is_none() {
+                    ends.0
+                } else if x >= r && right.is_none() {
+                    ends.1
+                } else if l > 0.0 {
+                    (l * r).sqrt()
+                } else {
+                    0.5 * (l + r)
+                };
+            }
+            let (f, d, h) = self.f_slope_curv(zlo, zhi, x);
+            if d == 0.0 || f == 0.0 {
+                return f;
+            }
+            if d < 0.0 {
+                if x == ends.1 {
+                    return f;
+                }
+                left = Some((x, f, d));
+            } else {
+                if x == ends.0 {
+                    return f;
+                }
+                right = Some((x, f, d));
+            }
+            let step = d / h;
+            if let (Some((x1, f1, d1)), Some((x2, f2, d2))) = (left, right) {
+                let xc = (f2 - f1 + d1 * x1 - d2 * x2) / (d1 - d2);
+                lb = f1 + d1 * (xc - x1);
+                // Decided (as for small data).
+                if lb >= target || f1.min(f2) < target || f1.min(f2) - lb <= self.bound_tol {
+                    break;
+                }
+                x -= step;
+            } else {
+                // One side only: a Newton step a little long, to reach the other side (f' is
+                // piecewise linear, so an exact step lands on the minimum itself).
+                x -= step * (1.0 + 1e-3);
+            }
+        }
+        lb
     }
 }
 
@@ -142,7 +232,8 @@ impl Landscape for PowerLaw {
     fn add_row(&mut self, axis: usize, t: f64) -> Result<(), String> {
         let c = if axis == 0 { &self.c1 } else { &self.c2 };
         let sign = if axis == 0 { -1.0 } else { 1.0 };
-        let row: Vec<f64> = c.iter().map(|x| (sign * t * x).exp()).collect();
+        let mut row = vec![0.0; self.n];
+        sums::fill(&mut row, |i| (sign * t * c[i]).exp());
         let bad = row.iter().any(|z| !z.is_finite());
         self.rows[axis].extend(row);
         self.t[axis].push(t);
@@ -162,12 +253,14 @@ impl Landscape for PowerLaw {
     fn bound(&self, lo: [usize; 2], hi: [usize; 2], target: f64) -> Bound {
         let (za0, za1) = (self.row(0, lo[0]), self.row(0, hi[0]));
         let (zb0, zb1) = (self.row(1, lo[1]), self.row(1, hi[1]));
-        let mut zlo = Vec::with_capacity(self.n);
-        let mut zhi = Vec::with_capacity(self.n);
-        for i in 0..self.n {
-            zlo.push(za0[i].min(za1[i]) * zb0[i].min(zb1[i]) * (1.0 - Z_SLACK));
-            zhi.push(za0[i].max(za1[i]) * zb0[i].max(zb1[i]) * (1.0 + Z_SLACK));
-        }
+        let mut scratch = self.scratch.borrow_mut();
+        let (zlo, zhi) = &mut *scratch;
+        sums::fill(zlo, |i| {
+            za0[i].min(za1[i]) * zb0[i].min(zb1[i]) * (1.0 - Z_SLACK)
+        });
+        sums::fill(zhi, |i| {
+            za0[i].max(za1[i]) * zb0[i].max(zb1[i]) * (1.0 + Z_SLACK)
+        });
         // The box of the centred amplitude over the cell: the shift is linear in a and b.
         let (a0, a1) = (self.t[0][lo[0]], self.t[0][hi[0]]);
         let (b0, b1) = (self.t[1][lo[1]], self.t[1][hi[1]]);
@@ -184,14 +277,22 @@ impl Landscape for PowerLaw {
         let wa = (a1 - a0) * self.sens[0];
         let wb = (b1 - b0) * self.sens[1];
         let loose = |_: f64| [wa * wa, wb * wb];
-        let (mut f1, mut d1, _) = self.f_slope_curv(&zlo, &zhi, x1);
+        if sums::is_large(self.n) {
+            let lb = self.bound_from_inside(zlo, zhi, (x1, x2), target);
+            // chi2 >= 0 always; a NaN bound (overflow) is passed on for the search to report.
+            return Bound {
+                lb: if lb < 0.0 { 0.0 } else { lb },
+                loose: loose(0.0),
+            };
+        }
+        let (mut f1, mut d1, _) = self.f_slope_curv(zlo, zhi, x1);
         if d1 >= 0.0 {
             return Bound {
                 lb: f1,
                 loose: loose(x1),
             };
         }
-        let (mut f2, mut d2, _) = self.f_slope_curv(&zlo, &zhi, x2);
+        let (mut f2, mut d2, _) = self.f_slope_curv(zlo, zhi, x2);
         if d2 <= 0.0 {
             return Bound {
                 lb: f2,
@@ -201,12 +302,17 @@ impl Landscape for PowerLaw {
         // f'(x1) < 0 < f'(x2): the tangents' crossing is a lower bound. Newton steps on the
         // piecewise linear f' (exact on each piece) move the bracket in; bisection (geometric, A
         // spans decades) when a step leaves it. Start from the least-squares A at the middle z.
-        let (mut num, mut den) = (0.0, 0.0);
-        for i in 0..self.n {
-            let z = 0.5 * (zlo[i] + zhi[i]);
-            num += self.w[i] * z * self.y[i];
-            den += self.w[i] * z * z;
-        }
+        let (y, w) = (&self.y[..], &self.w[..]);
+        let (zl, zh) = (&zlo[..], &zhi[..]);
+        let [num, den] = sums::sum(self.n, |points| {
+            let (mut num, mut den) = (0.0, 0.0);
+            for i in points {
+                let z = 0.5 * (zl[i] + zh[i]);
+                num += w[i] * z * y[i];
+                den += w[i] * z * z;
+            }
+            [num, den]
+        });
         let mut x = num / den;
         let mut lb = f64::NEG_INFINITY;
         for _ in 0..POWERLAW_BOUND_ITERS {
@@ -217,7 +323,7 @@ impl Landscape for PowerLaw {
                     0.5 * (x1 + x2)
                 };
             }
-            let (f, d, h) = self.f_slope_curv(&zlo, &zhi, x);
+            let (f, d, h) = self.f_slope_curv(zlo, zhi, x);
             if d == 0.0 || f == 0.0 {
                 lb = f;
                 break;
