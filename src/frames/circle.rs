@@ -204,28 +204,10 @@ pub fn fit_geometric(
     if !c.is_finite() {
         return Err(FitError::Degenerate);
     }
-    let cost = |c: &Circle| pts.iter().map(|&p| c.distance(p).powi(2)).sum::<f64>();
-    let mut f = cost(&c);
+    let mut ne = normal_equations(pts, &c);
     let mut lambda = 1e-3;
     for it in 0..100 {
-        // Normal equations J^T J and J^T res for (cx, cy[, r]).
-        let mut jtj = [[0.0f64; 3]; 3];
-        let mut jtr = [0.0f64; 3];
-        for &p in pts {
-            let (dx, dy) = (p[0] - c.cx, p[1] - c.cy);
-            let d = (dx * dx + dy * dy).sqrt();
-            if d == 0.0 {
-                continue;
-            }
-            let j = [-dx / d, -dy / d, -1.0];
-            let res = d - c.r;
-            for a in 0..np {
-                jtr[a] += j[a] * res;
-                for b in 0..np {
-                    jtj[a][b] += j[a] * j[b];
-                }
-            }
-        }
+        let (f, jtj, jtr) = ne;
         let mut accepted = false;
         for _ in 0..20 {
             let mut m = jtj;
@@ -241,16 +223,19 @@ pub fn fit_geometric(
                 cy: c.cy - step[1],
                 r: if np == 3 { c.r - step[2] } else { c.r },
             };
-            let ft = cost(&trial);
+            // The trial's cost comes with its normal equations, which the next iteration
+            // needs if the step is taken.
+            let nt = normal_equations(pts, &trial);
+            let ft = nt.0;
             if trial.is_finite() && ft.is_finite() && ft <= f {
                 let moved = step[0].hypot(step[1]).max(step[2].abs());
                 let gain = f - ft;
                 c = trial;
-                f = ft;
+                ne = nt;
                 lambda = (lambda * 0.1).max(1e-12);
                 accepted = true;
-                if moved <= 1e-10 * c.r.max(1.0) || gain <= 1e-13 * f {
-                    return finish(pts, c, &jtj, np, it + 1);
+                if moved <= 1e-10 * c.r.max(1.0) || gain <= 1e-13 * ft {
+                    return finish(pts.len(), c, ft, &jtj, np, it + 1);
                 }
                 break;
             }
@@ -258,21 +243,56 @@ pub fn fit_geometric(
         }
         if !accepted {
             // No downhill step at any damping: a minimum to rounding.
-            return finish(pts, c, &jtj, np, it + 1);
+            return finish(pts.len(), c, f, &jtj, np, it + 1);
         }
     }
     Err(FitError::NotConverged)
 }
 
+/// At circle `c`: the sum of squared distances of `pts`, and the normal equations J^T J and
+/// J^T res of the distances in (cx, cy, r) (all three; a fixed-radius fit uses the leading
+/// 2 x 2 block). One pass, one square root per point. Points at the centre have no gradient
+/// and are left out of the normal equations.
+fn normal_equations(pts: &[[f64; 2]], c: &Circle) -> (f64, [[f64; 3]; 3], [f64; 3]) {
+    let mut f = 0.0;
+    let (mut sxx, mut sxy, mut syy, mut sx, mut sy, mut n) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    let (mut rx, mut ry, mut rr) = (0.0, 0.0, 0.0);
+    for &p in pts {
+        let (dx, dy) = (p[0] - c.cx, p[1] - c.cy);
+        let d = (dx * dx + dy * dy).sqrt();
+        let res = d - c.r;
+        f += res * res;
+        if d == 0.0 {
+            continue;
+        }
+        // One division per point, not two.
+        let inv = 1.0 / d;
+        let (jx, jy) = (-dx * inv, -dy * inv);
+        rx += jx * res;
+        ry += jy * res;
+        rr += -res;
+        sxx += jx * jx;
+        sxy += jx * jy;
+        syy += jy * jy;
+        sx += -jx;
+        sy += -jy;
+        n += 1.0;
+    }
+    (
+        f,
+        [[sxx, sxy, sx], [sxy, syy, sy], [sx, sy, n]],
+        [rx, ry, rr],
+    )
+}
+
 fn finish(
-    pts: &[[f64; 2]],
+    n: usize,
     c: Circle,
+    ss: f64,
     jtj: &[[f64; 3]; 3],
     np: usize,
     iterations: usize,
 ) -> Result<Geometric, FitError> {
-    let n = pts.len();
-    let ss: f64 = pts.iter().map(|&p| c.distance(p).powi(2)).sum();
     let rms = (ss / n as f64).sqrt();
     let dof = n.saturating_sub(np).max(1) as f64;
     let s2 = ss / dof;
@@ -468,6 +488,31 @@ mod tests {
         assert!((g.circle.r - TRUE.r).abs() < 1e-9);
         assert!((g.circle.cx - TRUE.cx).abs() < 1e-9);
         assert!((g.rms - a).abs() < 1e-9);
+    }
+
+    // The sums by hand for 8 points spaced 45 degrees round a circle of radius R, evaluated at
+    // the same centre and radius R + d: every residual is -d, every gradient row is
+    // (-cos t, -sin t, -1). Sums of cos^2 and sin^2 over the 8 angles are 4 each, of cos,
+    // sin and cos sin 0. So f = 8 d^2, J^T J = [[4, 0, 0], [0, 4, 0], [0, 0, 8]],
+    // J^T res = [0, 0, 8 d]. 1e-12: rounding of sums of 8 terms of order 1.
+    #[test]
+    fn normal_equations_known_sums() {
+        let d = 0.25;
+        let p = arc(TRUE, 0.0, 315.0, 8);
+        let at = Circle {
+            r: TRUE.r + d,
+            ..TRUE
+        };
+        let (f, jtj, jtr) = normal_equations(&p, &at);
+        assert!((f - 8.0 * d * d).abs() < 1e-12, "{f}");
+        let want = [[4.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 8.0]];
+        for a in 0..3 {
+            for b in 0..3 {
+                assert!((jtj[a][b] - want[a][b]).abs() < 1e-12, "{jtj:?}");
+            }
+        }
+        assert!(jtr[0].abs() < 1e-12 && jtr[1].abs() < 1e-12, "{jtr:?}");
+        assert!((jtr[2] - 8.0 * d).abs() < 1e-12, "{jtr:?}");
     }
 
     #[test]

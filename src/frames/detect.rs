@@ -10,7 +10,7 @@
 
 use super::GrayImage;
 use super::circle::{Circle, FitError, fit_robust};
-use super::edges::{EdgePoint, ProfileSettings, derivative_kernel, ray_edge};
+use super::edges::{EdgePoint, ProfileSettings, derivative_kernel, ray_edge_dir};
 use super::markers::{Marker, find_markers};
 use super::segment::{Coarse, CoarseError, coarse};
 
@@ -146,7 +146,8 @@ pub fn coverage_deg(c: &Circle, pts: impl Iterator<Item = [f64; 2]>) -> f64 {
     if a.len() < 2 {
         return 0.0;
     }
-    a.sort_by(|x, y| x.total_cmp(y));
+    // Values equal under total_cmp are the same bits: an unstable sort gives the same order.
+    a.sort_unstable_by(|x, y| x.total_cmp(y));
     let mut gap = a[0] + std::f64::consts::TAU - a[a.len() - 1];
     for w in a.windows(2) {
         gap = gap.max(w[1] - w[0]);
@@ -179,19 +180,20 @@ impl Pass<'_> {
         let mut out = Vec::with_capacity(n_rays);
         for k in 0..n_rays {
             let a = std::f64::consts::TAU * k as f64 / n_rays as f64;
-            let e = [c.cx + c.r * a.cos(), c.cy + c.r * a.sin()];
-            if others
-                .iter()
-                .any(|o| (e[0] - o.cx).hypot(e[1] - o.cy) < o.r + margin)
-            {
+            let dir = [a.cos(), a.sin()];
+            let e = [c.cx + c.r * dir[0], c.cy + c.r * dir[1]];
+            if others.iter().any(|o| {
+                let (dx, dy) = (e[0] - o.cx, e[1] - o.cy);
+                dx * dx + dy * dy < (o.r + margin) * (o.r + margin)
+            }) {
                 continue;
             }
-            if let Some(p) = ray_edge(
+            if let Some(p) = ray_edge_dir(
                 self.img,
                 [c.cx, c.cy],
                 a,
-                lo,
-                hi,
+                dir,
+                [lo, hi],
                 self.polarity,
                 &self.kernel,
                 &self.profile,
@@ -207,8 +209,8 @@ impl Pass<'_> {
         }
         let typical = |f: fn(&EdgePoint) -> f64| {
             let mut s: Vec<f64> = out.iter().map(f).collect();
-            s.sort_by(|a, b| a.total_cmp(b));
-            s[(s.len() - 1) * 3 / 4]
+            let k = (s.len() - 1) * 3 / 4;
+            *s.select_nth_unstable_by(k, |a, b| a.total_cmp(b)).1
         };
         let strength_floor = (0.3 * typical(|p| p.strength)).max(self.noise_floor);
         let step_floor = self.step_fraction * typical(|p| p.step);

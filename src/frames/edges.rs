@@ -169,7 +169,34 @@ pub fn ray_edge(
     s: &ProfileSettings,
     buf: &mut Vec<f64>,
 ) -> Option<EdgePoint> {
-    let (dc, ds) = (angle.cos(), angle.sin());
+    let dir = [angle.cos(), angle.sin()];
+    ray_edge_dir(
+        img,
+        centre,
+        angle,
+        dir,
+        [r_lo, r_hi],
+        polarity,
+        kernel,
+        s,
+        buf,
+    )
+}
+
+/// `ray_edge` with the ray's direction (cos, sin of `angle`) given, for callers that have it.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn ray_edge_dir(
+    img: &GrayImage,
+    centre: [f64; 2],
+    angle: f64,
+    dir: [f64; 2],
+    [r_lo, r_hi]: [f64; 2],
+    polarity: f64,
+    kernel: &[f64],
+    s: &ProfileSettings,
+    buf: &mut Vec<f64>,
+) -> Option<EdgePoint> {
+    let [dc, ds] = dir;
     let (tc, ts) = (-ds, dc);
     let n = ((r_hi - r_lo) / s.step).floor() as usize + 1;
     let half = kernel.len() / 2;
@@ -207,7 +234,8 @@ pub fn ray_edge(
             let a = sample(u, v);
             let b = sample(u + s.spread * tc, v + s.spread * ts);
             let c = sample(u - s.spread * tc, v - s.spread * ts);
-            buf.push((a + b + c) / 3.0);
+            // A product, not a division: the divider's latency held up the whole loop.
+            buf.push((a + b + c) * (1.0 / 3.0));
         }
     }
     for i in (0..n).filter(|_| !all_inside) {
@@ -221,7 +249,7 @@ pub fn ray_edge(
                 if first_valid.is_none() {
                     first_valid = Some(i);
                 }
-                buf.push((a + b + c) / 3.0);
+                buf.push((a + b + c) * (1.0 / 3.0));
             }
             _ => {
                 if first_valid.is_some() {

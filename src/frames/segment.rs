@@ -100,29 +100,39 @@ fn coarse_image(img: &GrayImage, factor: usize) -> GrayImage {
         acc.fill(0.0);
         for rr in r * factor..(r + 1) * factor {
             let row = &img.pixels[rr * img.width..rr * img.width + w * factor];
-            for (a, block) in acc.iter_mut().zip(row.chunks_exact(factor)) {
-                *a += block.iter().sum::<f32>();
+            if factor == 2 {
+                // The common case (frames up to ~256 x 256), without the inner loop.
+                for (a, pair) in acc.iter_mut().zip(row.chunks_exact(2)) {
+                    *a += pair[0] + pair[1];
+                }
+            } else {
+                for (a, block) in acc.iter_mut().zip(row.chunks_exact(factor)) {
+                    *a += block.iter().sum::<f32>();
+                }
             }
         }
         for (o, a) in out.pixels[r * w..(r + 1) * w].iter_mut().zip(&acc) {
             *o = a * inv;
         }
     }
+    // Row slices rather than `get`: the same sums without per-pixel bounds arithmetic.
     let mut tmp = out.clone();
-    for r in 0..h {
+    for (src, dst) in out
+        .pixels
+        .chunks_exact(w)
+        .zip(tmp.pixels.chunks_exact_mut(w))
+    {
         for c in 0..w {
-            let a = out.get(c.saturating_sub(1), r);
-            let b = out.get(c, r);
-            let d = out.get((c + 1).min(w - 1), r);
-            tmp.pixels[r * w + c] = 0.25 * a + 0.5 * b + 0.25 * d;
+            let (a, b, d) = (src[c.saturating_sub(1)], src[c], src[(c + 1).min(w - 1)]);
+            dst[c] = 0.25 * a + 0.5 * b + 0.25 * d;
         }
     }
     for r in 0..h {
-        for c in 0..w {
-            let a = tmp.get(c, r.saturating_sub(1));
-            let b = tmp.get(c, r);
-            let d = tmp.get(c, (r + 1).min(h - 1));
-            out.pixels[r * w + c] = 0.25 * a + 0.5 * b + 0.25 * d;
+        let up = &tmp.pixels[r.saturating_sub(1) * w..][..w];
+        let mid = &tmp.pixels[r * w..][..w];
+        let down = &tmp.pixels[(r + 1).min(h - 1) * w..][..w];
+        for (c, o) in out.pixels[r * w..(r + 1) * w].iter_mut().enumerate() {
+            *o = 0.25 * up[c] + 0.5 * mid[c] + 0.25 * down[c];
         }
     }
     out
@@ -253,43 +263,61 @@ fn fit_background(img: &GrayImage, use_px: &[bool]) -> Option<[f64; 6]> {
 }
 
 /// The q_lo- and q_hi-quantiles of `v` (nearest rank, q_lo <= q_hi; the ranks
-/// floor((n - 1) q) in the order of `total_cmp`). Tails of up to 4 096 values are kept in sorted
-/// buffers in one pass (few values enter them); longer ones are selected in a copy.
+/// floor((n - 1) q) in the order of `total_cmp`). A histogram of the top 12 bits of
+/// order-preserving integer keys (sign, exponent, 3 mantissa bits) finds the bin that holds
+/// each rank in one pass; the rank is then selected among that bin's values only.
 fn quantiles(v: &[f32], q_lo: f64, q_hi: f64) -> (f32, f32) {
     let n = v.len();
     let k_lo = ((n - 1) as f64 * q_lo) as usize;
     let k_hi = ((n - 1) as f64 * q_hi) as usize;
-    let (m_lo, m_hi) = (k_lo + 1, n - k_hi);
-    if m_lo.max(m_hi) > 4_096 {
-        let mut s = v.to_vec();
-        let hi = *s.select_nth_unstable_by(k_hi, |a, b| a.total_cmp(b)).1;
-        let lo = *s[..=k_hi]
-            .select_nth_unstable_by(k_lo, |a, b| a.total_cmp(b))
-            .1;
-        return (lo, hi);
-    }
-    // `small` holds the m_lo smallest values so far, ascending; `large` the m_hi largest,
-    // descending. Values are compared by integer keys in the order of `total_cmp`.
+    // Unsigned keys in the order of `total_cmp`: negatives (sign bit set) have all bits
+    // flipped, the others only the sign bit.
     let key = |x: f32| {
-        let b = x.to_bits() as i32;
-        b ^ (((b >> 31) as u32) >> 1) as i32
+        let b = x.to_bits();
+        b ^ (((b as i32 >> 31) as u32) | 0x8000_0000)
     };
-    let mut small: Vec<(i32, f32)> = Vec::with_capacity(m_lo + 1);
-    let mut large: Vec<(i32, f32)> = Vec::with_capacity(m_hi + 1);
+    let unkey = |k: u32| {
+        f32::from_bits(if k & 0x8000_0000 != 0 {
+            k ^ 0x8000_0000
+        } else {
+            !k
+        })
+    };
+    const SHIFT: u32 = 20;
+    let mut hist = vec![0u32; 1 << (32 - SHIFT)];
+    for &x in v {
+        hist[(key(x) >> SHIFT) as usize] += 1;
+    }
+    // The bin holding rank k, and how many values lie in lower bins.
+    let bin_of = |k: usize| {
+        let mut below = 0usize;
+        for (b, &c) in hist.iter().enumerate() {
+            if below + c as usize > k {
+                return (b as u32, below);
+            }
+            below += c as usize;
+        }
+        unreachable!("rank {k} of {n} values")
+    };
+    let (b_lo, below_lo) = bin_of(k_lo);
+    let (b_hi, below_hi) = bin_of(k_hi);
+    let (mut in_lo, mut in_hi) = (Vec::new(), Vec::new());
     for &x in v {
         let kx = key(x);
-        if small.len() < m_lo || kx < small[m_lo - 1].0 {
-            let at = small.partition_point(|y| y.0 <= kx);
-            small.insert(at, (kx, x));
-            small.truncate(m_lo);
-        }
-        if large.len() < m_hi || kx > large[m_hi - 1].0 {
-            let at = large.partition_point(|y| y.0 >= kx);
-            large.insert(at, (kx, x));
-            large.truncate(m_hi);
+        if kx >> SHIFT == b_lo {
+            in_lo.push(kx);
+        } else if kx >> SHIFT == b_hi {
+            in_hi.push(kx);
         }
     }
-    (small[m_lo - 1].1, large[m_hi - 1].1)
+    let lo = *in_lo.select_nth_unstable(k_lo - below_lo).1;
+    // One bin may hold both ranks.
+    let hi = if b_hi == b_lo {
+        *in_lo.select_nth_unstable(k_hi - below_lo).1
+    } else {
+        *in_hi.select_nth_unstable(k_hi - below_hi).1
+    };
+    (unkey(lo), unkey(hi))
 }
 
 /// `resid` = `img` minus the quadratic surface `a` (as `fit_background` scales X and Y).
@@ -586,8 +614,9 @@ fn blob_seeds(
 mod tests {
     use super::*;
 
-    // Both branches (tail buffers, and selection for tails over 4 096 values) against the
-    // nearest ranks of a sorted copy, on values with ties, signs and a -0.0.
+    // Against the nearest ranks of a sorted copy, on values with ties, signs, a -0.0, an
+    // infinity and NaNs of both signs (all ordered by `total_cmp`), with both ranks in one
+    // histogram bin (0.3, 0.7: most values share few bins) and in different ones.
     #[test]
     fn quantiles_match_sorted_ranks() {
         let mut state = 7u64;
@@ -600,12 +629,26 @@ mod tests {
             })
             .collect();
         v[17] = -0.0;
+        v[5] = f32::NAN;
+        v[6] = -f32::NAN;
+        v[7] = f32::INFINITY;
         let mut sorted = v.clone();
         sorted.sort_by(|a, b| a.total_cmp(b));
-        for (lo, hi) in [(0.005, 0.995), (0.0, 1.0), (0.3, 0.7)] {
+        // (0.8, 0.81): about 6.0 and 6.2, one bin [6, 6.5).
+        for (lo, hi) in [
+            (0.005, 0.995),
+            (0.0, 1.0),
+            (0.3, 0.7),
+            (0.5, 0.5),
+            (0.8, 0.81),
+        ] {
             let (a, b) = quantiles(&v, lo, hi);
             let rank = |q: f64| sorted[((v.len() - 1) as f64 * q) as usize];
-            assert_eq!((a, b), (rank(lo), rank(hi)), "{lo} {hi}");
+            assert_eq!(
+                (a.to_bits(), b.to_bits()),
+                (rank(lo).to_bits(), rank(hi).to_bits()),
+                "{lo} {hi}"
+            );
         }
     }
 
@@ -615,6 +658,43 @@ mod tests {
         v.extend(vec![0.7f32; 300]);
         let t = otsu(&v);
         assert!(t > 0.2 && t <= 0.7, "{t}");
+    }
+
+    // A ramp v = col + 10 row: block means are the ramp at the block centres, and the binomial
+    // smoothing keeps a linear function except on the border rows and columns, where the
+    // replicated edge shifts it by a quarter of a coarse step (2 per coarse column, 20 per
+    // coarse row for factor 2). Factor 2 and factor 3 take different summing paths. Tolerance
+    // 1e-4: f32 rounding of values below 100 (1/9 is not exact), far below the 0.5 tested.
+    #[test]
+    fn coarse_image_of_a_ramp() {
+        for (factor, w, h) in [(2usize, 10usize, 8usize), (3, 13, 9)] {
+            let mut img = GrayImage::filled(w, h, 0.0);
+            for r in 0..h {
+                for c in 0..w {
+                    img.set(c, r, (c + 10 * r) as f32);
+                }
+            }
+            let out = coarse_image(&img, factor);
+            let (cw, ch) = (w / factor, h / factor);
+            assert_eq!((out.width, out.height), (cw, ch));
+            let f = factor as f32;
+            for r in 0..ch {
+                for c in 0..cw {
+                    let mean = (c as f32 + 0.5) * f - 0.5 + 10.0 * ((r as f32 + 0.5) * f - 0.5);
+                    let edge = |i: usize, n: usize, step: f32| match i {
+                        0 => 0.25 * step,
+                        i if i == n - 1 => -0.25 * step,
+                        _ => 0.0,
+                    };
+                    let want = mean + edge(c, cw, f) + edge(r, ch, 10.0 * f);
+                    let got = out.get(c, r);
+                    assert!(
+                        (got - want).abs() < 1e-4,
+                        "factor {factor} at ({c}, {r}): {got} vs {want}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]
