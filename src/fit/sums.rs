@@ -43,7 +43,7 @@ pub fn sum<const K: usize>(n: usize, part: impl Fn(Range<usize>) -> [f64; K] + S
     s
 }
 
-/// out[i] = f(i) for every i (each value is computed alone, so the order does not matter; in
+/// `out[i] = f(i)` for every i (each value is computed alone, so the order does not matter; in
 /// parallel for large data).
 pub fn fill(out: &mut [f64], f: impl Fn(usize) -> f64 + Sync) {
     if !is_large(out.len()) {

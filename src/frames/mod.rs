@@ -40,6 +40,7 @@ impl GrayImage {
 pub mod circle;
 pub mod detect;
 pub mod edges;
+pub mod levels;
 pub mod markers;
 pub mod morphology;
 pub mod render;
