@@ -75,54 +75,50 @@ impl<'a> Separable<'a> {
         let (f0, f1) = (self.row(0, lo[0]), self.row(0, hi[0]));
         let (g0, g1) = (self.row(1, lo[1]), self.row(1, hi[1]));
         let (e, w, slack) = (&self.e[..], &self.w[..], self.slack);
+        // F falls along axis 0, G rises along axis 1: the extremes are opposite corners. Point
+        // i's top of the cell, and its distance outside [bottom, top] widened by the slack.
+        let gap = |i: usize| {
+            let top = c(f0[i], g1[i]);
+            let bottom = c(f1[i], g0[i]) - slack;
+            let ei = e[i];
+            let d = if ei < bottom {
+                bottom - ei
+            } else if ei > top + slack {
+                ei - top - slack
+            } else {
+                0.0
+            };
+            (top, d)
+        };
+        // Point i's looseness along each axis (chooses the axis to split, never decides a cell).
+        let loose = |i: usize, top: f64| {
+            let r = (top - e[i]).abs();
+            let d0 = top - c(f1[i], g1[i]);
+            let d1 = top - c(f0[i], g0[i]);
+            (w[i] * d0 * (r + d0), w[i] * d1 * (r + d1))
+        };
         let large = sums::is_large(self.n);
         let [lb, l0, l1] = sums::sum(self.n, |points| {
             let (mut lb, mut l0, mut l1) = (0.0, 0.0, 0.0);
             if large {
-                // The bound over every point; the looseness (which only chooses the axis to
-                // split, never decides a cell) from every LOOSE_STRIDE-th.
+                // The bound over every point; the looseness from every LOOSE_STRIDE-th.
                 for i in points.clone() {
-                    let top = c(f0[i], g1[i]);
-                    let bottom = c(f1[i], g0[i]) - slack;
-                    let ei = e[i];
-                    let d = if ei < bottom {
-                        bottom - ei
-                    } else if ei > top + slack {
-                        ei - top - slack
-                    } else {
-                        0.0
-                    };
+                    let (_, d) = gap(i);
                     lb += w[i] * d * d;
                 }
                 for i in points.step_by(LOOSE_STRIDE) {
-                    let top = c(f0[i], g1[i]);
-                    let r = (top - e[i]).abs();
-                    let d0 = top - c(f1[i], g1[i]);
-                    let d1 = top - c(f0[i], g0[i]);
-                    l0 += w[i] * d0 * (r + d0);
-                    l1 += w[i] * d1 * (r + d1);
+                    let (a0, a1) = loose(i, gap(i).0);
+                    l0 += a0;
+                    l1 += a1;
                 }
                 return [lb, l0, l1];
             }
             for i in points {
-                // F falls along axis 0, G rises along axis 1: the extremes are opposite corners.
-                let top = c(f0[i], g1[i]);
-                let bottom = c(f1[i], g0[i]) - slack;
-                let ei = e[i];
-                let d = if ei < bottom {
-                    bottom - ei
-                } else if ei > top + slack {
-                    ei - top - slack
-                } else {
-                    0.0
-                };
-                let wi = w[i];
-                lb += wi * d * d;
-                let r = (top - ei).abs();
-                let d0 = top - c(f1[i], g1[i]);
-                let d1 = top - c(f0[i], g0[i]);
-                l0 += wi * d0 * (r + d0);
-                l1 += wi * d1 * (r + d1);
+                let (top, d) = gap(i);
+                lb += w[i] * d * d;
+                let (a0, a1) = loose(i, top);
+                l0 += a0;
+                l1 += a1;
             }
             [lb, l0, l1]
         });

@@ -157,14 +157,9 @@ impl PowerLaw {
 }
 
 impl PowerLaw {
-    /// The minimum of f over the box of A, bounded below as in [`Landscape::bound`] for small
-    /// data, but starting from the least-squares A at the middle z and evaluating the box's ends
-    /// only when a step leaves the bracket: near the minimum (where nearly all cells are) the
-    /// two evaluations at the ends of a box of decades were a third of the work. Any two
-    /// tangents with slopes of opposite signs cross below the minimum of the convex f; a slope
-    /// of the wrong sign at a box end puts the minimum over the box there. Without both kinds of
-    /// tangent after the iterations, -inf (no bound: the cell is split).
-    fn bound_from_inside(&self, zlo: &[f64], zhi: &[f64], ends: (f64, f64), target: f64) -> f64 {
+    /// The least-squares amplitude A with every point's z at the middle of its range: the start
+    /// of both bound iterations.
+    fn amplitude_at_middle(&self, zlo: &[f64], zhi: &[f64]) -> f64 {
         let (y, w) = (&self.y[..], &self.w[..]);
         let [num, den] = sums::sum(self.n, |points| {
             let (mut num, mut den) = (0.0, 0.0);
@@ -175,7 +170,18 @@ impl PowerLaw {
             }
             [num, den]
         });
-        let mut x = num / den;
+        num / den
+    }
+
+    /// The minimum of f over the box of A, bounded below as in [`Landscape::bound`] for small
+    /// data, but starting from the least-squares A at the middle z and evaluating the box's ends
+    /// only when a step leaves the bracket: near the minimum (where nearly all cells are) the
+    /// two evaluations at the ends of a box of decades were a third of the work. Any two
+    /// tangents with slopes of opposite signs cross below the minimum of the convex f; a slope
+    /// of the wrong sign at a box end puts the minimum over the box there. Without both kinds of
+    /// tangent after the iterations, -inf (no bound: the cell is split).
+    fn bound_from_inside(&self, zlo: &[f64], zhi: &[f64], ends: (f64, f64), target: f64) -> f64 {
+        let mut x = self.amplitude_at_middle(zlo, zhi);
         // The latest points with f' < 0 (left of the minimum) and f' > 0 (right of it).
         let mut left: Option<(f64, f64, f64)> = None;
         let mut right: Option<(f64, f64, f64)> = None;
@@ -302,18 +308,7 @@ impl Landscape for PowerLaw {
         // f'(x1) < 0 < f'(x2): the tangents' crossing is a lower bound. Newton steps on the
         // piecewise linear f' (exact on each piece) move the bracket in; bisection (geometric, A
         // spans decades) when a step leaves it. Start from the least-squares A at the middle z.
-        let (y, w) = (&self.y[..], &self.w[..]);
-        let (zl, zh) = (&zlo[..], &zhi[..]);
-        let [num, den] = sums::sum(self.n, |points| {
-            let (mut num, mut den) = (0.0, 0.0);
-            for i in points {
-                let z = 0.5 * (zl[i] + zh[i]);
-                num += w[i] * z * y[i];
-                den += w[i] * z * z;
-            }
-            [num, den]
-        });
-        let mut x = num / den;
+        let mut x = self.amplitude_at_middle(zlo, zhi);
         let mut lb = f64::NEG_INFINITY;
         for _ in 0..POWERLAW_BOUND_ITERS {
             if !(x > x1 && x < x2) {
