@@ -102,13 +102,21 @@ pub fn run(args: Args) -> CliResult {
         rule: args.contact_end,
         vm_method: &vm_method,
     };
-    // Rendered only when a file or the chosen format needs them (a fifth of a small fit's CPU).
-    let json = || -> Result<String, String> {
-        Ok(serde_json::to_string_pretty(&report::to_json(&ctx, &set))
-            .map_err(|e| format!("cannot render JSON: {e}"))?
-            + "\n")
+    // Each rendered once, and only when a file or the chosen format needs it (together a fifth
+    // of a small fit's CPU).
+    let files = args.out.is_some();
+    let json = if files || args.format == Format::Json {
+        let text = serde_json::to_string_pretty(&report::to_json(&ctx, &set))
+            .map_err(|e| format!("cannot render JSON: {e}"))?;
+        text + "\n"
+    } else {
+        String::new()
     };
-    let csv = || report::to_csv(&ctx, &set);
+    let csv = if files || args.format == Format::Csv {
+        report::to_csv(&ctx, &set)?
+    } else {
+        String::new()
+    };
     if let Some(dir) = &args.out {
         let name = args
             .data
@@ -130,8 +138,8 @@ pub fn run(args: Args) -> CliResult {
                 dir.join("params.md"),
                 report_text::to_markdown(&ctx, &set).into_bytes(),
             ),
-            (dir.join("params.csv"), csv()?.into_bytes()),
-            (dir.join("params.json"), json()?.into_bytes()),
+            (dir.join("params.csv"), csv.clone().into_bytes()),
+            (dir.join("params.json"), json.clone().into_bytes()),
             (dir.join("fig7.svg"), fig.into_bytes()),
             (dir.join("residuals.svg"), res.into_bytes()),
         ];
@@ -140,8 +148,8 @@ pub fn run(args: Args) -> CliResult {
     }
     match args.format {
         Format::Table => print!("{}", report_text::to_table(&ctx, &set)),
-        Format::Csv => print!("{}", csv()?),
-        Format::Json => print!("{}", json()?),
+        Format::Csv => print!("{csv}"),
+        Format::Json => print!("{json}"),
     }
     Ok(())
 }
