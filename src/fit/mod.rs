@@ -14,6 +14,7 @@ pub mod objective;
 pub mod polish;
 pub mod powerlaw;
 pub mod profile;
+pub mod qp;
 pub mod result;
 pub mod scalar;
 pub mod search;
