@@ -268,6 +268,7 @@ mod tests {
     }
 
     #[test]
+    #[allow(clippy::needless_range_loop)] // symmetric matrices read best by index
     fn cone_sections_agree_with_a_dense_sample() {
         // The power law's cell shape: A in [a_lo, a_hi], |B_k| <= A w_k. Random quadratics
         // (convex, indefinite and concave), each compared with q on a 41^3 grid over the
