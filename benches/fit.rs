@@ -60,7 +60,7 @@ fn bench(c: &mut Criterion) {
             let j = report::to_json(&ctx, &set).to_string();
             let m = report_text::to_markdown(&ctx, &set);
             let t = report_text::to_table(&ctx, &set);
-            let s = report::to_csv(&ctx, &set).unwrap();
+            let s = report::to_csv(&ctx, &set);
             let f = fig7_svg(data, &set, ContactEnd::Overlap, &VmMethod::Master, "fig7").unwrap();
             let r = residuals_svg(data, &set, "residuals").unwrap();
             j.len() + m.len() + t.len() + s.len() + f.len() + r.len()

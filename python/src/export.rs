@@ -65,8 +65,11 @@ fn input(e: ExportError) -> Failure {
     match e {
         ExportError::Input(m) => Failure::Input(m),
         ExportError::Data(d) => Failure::Data(d),
+        // The law asks for files the engine cannot take (an overdamped pair, contacts too
+        // different for one run): the caller's input.
+        e @ ExportError::Files { .. } => Failure::Input(e.to_string()),
         // LAMMPS missing or its output unreadable: not the caller's input.
-        ExportError::Engine(m) => Failure::Numerical(m),
+        ExportError::Engine(e) => Failure::Numerical(e.to_string()),
         // LAMMPS ran and disagrees: a numerical failure, not bad input.
         ExportError::Verify { message, .. } => Failure::Numerical(message),
         // The curves of laws.svg could not be evaluated or drawn: not the caller's input.

@@ -59,8 +59,8 @@ impl Fitted {
     }
 
     /// params.csv of `restitution fit --out` (and `--format csv`).
-    fn csv(&self) -> PyResult<String> {
-        report::to_csv(&self.ctx(), &self.set).map_err(pyo3::exceptions::PyValueError::new_err)
+    fn csv(&self) -> String {
+        report::to_csv(&self.ctx(), &self.set)
     }
 
     /// fig7.svg of `restitution fit --out`, with the given title.

@@ -113,7 +113,7 @@ pub fn run(args: Args) -> CliResult {
         String::new()
     };
     let csv = if files || args.format == Format::Csv {
-        report::to_csv(&ctx, &set)?
+        report::to_csv(&ctx, &set)
     } else {
         String::new()
     };

@@ -190,7 +190,8 @@ impl FramesArgs {
             "coordinates": "x_m, y_m: object plane, x right, y up, origin at the image's bottom-left corner; col_px, row_px from the left and top edges, pixel (c, r) spans [c, c+1) x [r, r+1)",
             "origin_m": origins,
         });
-        let files = rendered_files(dir, &filmed, self.bits, &settings)?;
+        let files =
+            rendered_files(dir, &filmed, self.bits, &settings).map_err(|e| e.to_string())?;
         for f in &filmed {
             let sub = dir.join(&f.id);
             std::fs::create_dir_all(&sub)

@@ -62,7 +62,7 @@ pub fn run(args: Args) -> CliResult {
         strict: args.strict,
     };
     // Checked before the frames are counted, so a bad flag fails at once.
-    request.settings()?;
+    request.settings().map_err(|e| e.to_string())?;
     let total: usize = args.dirs.iter().map(|d| count_frames(d)).sum();
     let bar = if std::io::stderr().is_terminal() {
         ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr())

@@ -5,14 +5,18 @@
 //! Submodules: [`plan`] (which law and files an export gives), [`lammps`] (in.restitution,
 //! collide.in), [`job`] (one export from request to files, for the command line and Python),
 //! [`run`] (running `lmp` on them and comparing e), [`files`] (constant_e.csv,
-//! table.csv, liggghts.in, export.json), [`report`] (the printed summary).
+//! table.csv, liggghts.in, export.json), [`report`] (the printed summary); the failures of the
+//! files and of the round trip are [`FilesFailure`] and [`RunFailure`].
 
+mod error;
 pub mod files;
 pub mod job;
 pub mod lammps;
 pub mod plan;
 pub mod report;
 pub mod run;
+
+pub use error::{FilesFailure, RunFailure};
 
 use super::{DataError, DataFailure};
 use crate::contact::Material;

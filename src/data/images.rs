@@ -23,21 +23,38 @@ fn data_err(path: &Path, kind: DataFailure, message: impl Into<String>) -> DataE
     }
 }
 
-/// The frame number in a file name: the last run of digits in the name without its extension
-/// (`shot3_frame0012.png` is frame 12).
-pub fn frame_number(stem: &str) -> Option<Result<i64, String>> {
+/// The frame number in a frame file's name: the last run of digits in the name without its
+/// extension (`shot3_frame0012.png` is frame 12). Errors: no digits in the name, or too many
+/// for an i64.
+pub fn frame_number(path: &Path) -> Result<i64, DataError> {
+    let stem = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_default();
     let bytes = stem.as_bytes();
-    let end = bytes.iter().rposition(|b| b.is_ascii_digit())? + 1;
+    let Some(end) = bytes
+        .iter()
+        .rposition(|b| b.is_ascii_digit())
+        .map(|i| i + 1)
+    else {
+        return Err(data_err(
+            path,
+            DataFailure::Schema,
+            "no frame number in the file name (frames are ordered by the integer in their names)",
+        ));
+    };
     let start = bytes[..end]
         .iter()
         .rposition(|b| !b.is_ascii_digit())
         .map_or(0, |i| i + 1);
     let digits = &stem[start..end];
-    Some(
-        digits
-            .parse::<i64>()
-            .map_err(|_| format!("frame number {digits} is too large")),
-    )
+    digits.parse::<i64>().map_err(|_| {
+        data_err(
+            path,
+            DataFailure::Value,
+            format!("frame number {digits} is too large"),
+        )
+    })
 }
 
 fn is_frame_file(p: &Path) -> bool {
@@ -73,21 +90,7 @@ pub fn list_frames(dir: &Path) -> Result<Vec<FrameFile>, DataError> {
         if name.starts_with('.') || !is_frame_file(&path) {
             continue;
         }
-        let stem = path
-            .file_stem()
-            .map(|s| s.to_string_lossy().to_string())
-            .unwrap_or_default();
-        let number = match frame_number(&stem) {
-            Some(Ok(n)) => n,
-            Some(Err(e)) => return Err(data_err(&path, DataFailure::Value, e)),
-            None => {
-                return Err(data_err(
-                    &path,
-                    DataFailure::Schema,
-                    "no frame number in the file name (frames are ordered by the integer in their names)",
-                ));
-            }
-        };
+        let number = frame_number(&path)?;
         out.push(FrameFile { path, number });
     }
     if out.is_empty() {
@@ -146,8 +149,9 @@ pub fn read_gray(path: &Path) -> Result<GrayImage, DataError> {
     })
 }
 
-/// Encodes a grey frame as an 8-bit PNG (for figures).
-pub fn encode_png(img: &GrayImage) -> Result<Vec<u8>, String> {
+/// Encodes a grey frame as an 8-bit PNG (for figures); `path` names the frame in messages (the
+/// file it was read from).
+pub fn encode_png(path: &Path, img: &GrayImage) -> Result<Vec<u8>, DataError> {
     use image::ImageEncoder;
     let bytes: Vec<u8> = img
         .pixels
@@ -162,7 +166,7 @@ pub fn encode_png(img: &GrayImage) -> Result<Vec<u8>, String> {
             img.height as u32,
             image::ExtendedColorType::L8,
         )
-        .map_err(|e| format!("encoding a PNG: {e}"))?;
+        .map_err(|e| data_err(path, DataFailure::Format, format!("encoding a PNG: {e}")))?;
     Ok(out)
 }
 
@@ -193,14 +197,17 @@ mod tests {
 
     #[test]
     fn numbers_from_names() {
-        assert_eq!(frame_number("frame0012"), Some(Ok(12)));
-        assert_eq!(frame_number("shot3_frame0012"), Some(Ok(12)));
-        assert_eq!(frame_number("7"), Some(Ok(7)));
-        assert_eq!(frame_number("cam2_x"), Some(Ok(2)));
-        assert_eq!(frame_number("frame"), None);
-        assert!(matches!(
-            frame_number("f99999999999999999999"),
-            Some(Err(_))
-        ));
+        let number = |name: &str| frame_number(Path::new(name));
+        assert_eq!(number("dir/frame0012.png"), Ok(12));
+        assert_eq!(number("shot3_frame0012.tif"), Ok(12));
+        assert_eq!(number("7.png"), Ok(7));
+        assert_eq!(number("cam2_x.png"), Ok(2));
+        let none = number("dir/frame.png").unwrap_err();
+        assert_eq!(
+            (none.path.as_str(), none.kind),
+            ("dir/frame.png", DataFailure::Schema)
+        );
+        let large = number("f99999999999999999999.png").unwrap_err();
+        assert_eq!(large.kind, DataFailure::Value, "{large}");
     }
 }

@@ -10,34 +10,72 @@ use image::ImageEncoder;
 use image::codecs::png::PngEncoder;
 use std::path::{Path, PathBuf};
 
+/// Why a frame could not be encoded as a grey PNG.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum PngFailure {
+    /// The frame's pixel count is not its width times its height, or it has no pixels.
+    #[error("frame of {width} x {height} pixels holds {values} values")]
+    Size {
+        width: usize,
+        height: usize,
+        values: usize,
+    },
+    /// The frame is wider (`"wide"`) or taller (`"tall"`) than PNG's 2^32 - 1 pixels.
+    #[error("frame too {0} for PNG")]
+    TooLarge(&'static str),
+    /// A bit depth other than 8 or 16.
+    #[error("PNG grey frames have 8 or 16 bits, not {0}")]
+    Bits(u32),
+    /// A pixel's level is outside [0, 1] or not finite.
+    #[error("pixel (col {col}, row {row}) = {value}: expected a level in [0, 1]")]
+    Level { col: usize, row: usize, value: f32 },
+    /// The PNG encoder refused the frame (its message).
+    #[error("encoding PNG: {0}")]
+    Encoder(String),
+}
+
+/// Why the files of rendered collisions could not be built.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum RenderedFilesError {
+    /// A collision id that cannot name a directory (empty, `.`, `..`, or with a path separator).
+    #[error("collision id '{0}' cannot name a directory")]
+    CollisionId(String),
+    /// A frame that cannot be encoded: the collision, the frame's index and why.
+    #[error("collision {collision} frame {frame}: {kind}")]
+    Frame {
+        collision: String,
+        frame: usize,
+        kind: PngFailure,
+    },
+}
+
 /// Encodes a frame as a grey PNG of 8 or 16 bits: each value in [0, 1] is scaled to the full
 /// range and rounded. A value outside [0, 1] or not finite is an error naming the pixel.
-pub fn encode_gray_png(img: &GrayImage, bits: u32) -> Result<Vec<u8>, String> {
+pub fn encode_gray_png(img: &GrayImage, bits: u32) -> Result<Vec<u8>, PngFailure> {
     if img.pixels.len() != img.width * img.height || img.width == 0 || img.height == 0 {
-        return Err(format!(
-            "frame of {} x {} pixels holds {} values",
-            img.width,
-            img.height,
-            img.pixels.len()
-        ));
+        return Err(PngFailure::Size {
+            width: img.width,
+            height: img.height,
+            values: img.pixels.len(),
+        });
     }
     let (w, h) = (
-        u32::try_from(img.width).map_err(|_| "frame too wide for PNG".to_string())?,
-        u32::try_from(img.height).map_err(|_| "frame too tall for PNG".to_string())?,
+        u32::try_from(img.width).map_err(|_| PngFailure::TooLarge("wide"))?,
+        u32::try_from(img.height).map_err(|_| PngFailure::TooLarge("tall"))?,
     );
     let full = match bits {
         8 => 255.0,
         16 => 65535.0,
-        _ => return Err(format!("PNG grey frames have 8 or 16 bits, not {bits}")),
+        _ => return Err(PngFailure::Bits(bits)),
     };
     let mut levels = Vec::with_capacity(img.pixels.len());
     for (i, &x) in img.pixels.iter().enumerate() {
         if !(x.is_finite() && (0.0..=1.0).contains(&x)) {
-            return Err(format!(
-                "pixel (col {}, row {}) = {x}: expected a level in [0, 1]",
-                i % img.width,
-                i / img.width
-            ));
+            return Err(PngFailure::Level {
+                col: i % img.width,
+                row: i / img.width,
+                value: x,
+            });
         }
         levels.push((x as f64 * full).round() as u16);
     }
@@ -52,7 +90,7 @@ pub fn encode_gray_png(img: &GrayImage, bits: u32) -> Result<Vec<u8>, String> {
         let bytes: Vec<u8> = levels.iter().flat_map(|l| l.to_ne_bytes()).collect();
         enc.write_image(&bytes, w, h, image::ExtendedColorType::L16)
     };
-    result.map_err(|e| format!("encoding PNG: {e}"))?;
+    result.map_err(|e| PngFailure::Encoder(e.to_string()))?;
     Ok(out)
 }
 
@@ -69,7 +107,7 @@ pub fn rendered_files(
     filmed: &[Filmed],
     bits: u32,
     settings: &serde_json::Value,
-) -> Result<Vec<(PathBuf, Vec<u8>)>, String> {
+) -> Result<Vec<(PathBuf, Vec<u8>)>, RenderedFilesError> {
     let mut files = Vec::new();
     let mut w = csv::Writer::from_writer(Vec::new());
     let header = [
@@ -95,16 +133,21 @@ pub fn rendered_files(
         "qz",
         "in_view",
     ];
-    let csv_err = |e: csv::Error| format!("writing truth.csv: {e}");
-    w.write_record(header).map_err(csv_err)?;
+    // Writing CSV into memory cannot fail: the writer's only errors are I/O (none into a `Vec`)
+    // and records of unequal length (each has the header's by construction).
+    const IN_MEMORY: &str = "writing CSV into memory cannot fail";
+    w.write_record(header).expect(IN_MEMORY);
     for f in filmed {
         if f.id.is_empty() || f.id.contains(['/', '\\']) || f.id == "." || f.id == ".." {
-            return Err(format!("collision id '{}' cannot name a directory", f.id));
+            return Err(RenderedFilesError::CollisionId(f.id.clone()));
         }
         for (k, (img, t)) in f.frames.iter().zip(&f.truth).enumerate() {
             let name = frame_file_name(k);
-            let png = encode_gray_png(img, bits)
-                .map_err(|e| format!("collision {} frame {k}: {e}", f.id))?;
+            let png = encode_gray_png(img, bits).map_err(|kind| RenderedFilesError::Frame {
+                collision: f.id.clone(),
+                frame: k,
+                kind,
+            })?;
             files.push((dir.join(&f.id).join(&name), png));
             for (i, s) in t.spheres.iter().enumerate() {
                 let mut rec = vec![
@@ -131,15 +174,14 @@ pub fn rendered_files(
                     .map(|&x| fmt_num(x)),
                 );
                 rec.push(s.in_view.to_string());
-                w.write_record(&rec).map_err(csv_err)?;
+                w.write_record(&rec).expect(IN_MEMORY);
             }
         }
     }
-    let truth = w
-        .into_inner()
-        .map_err(|e| format!("writing truth.csv: {e}"))?;
+    let truth = w.into_inner().expect(IN_MEMORY);
     files.push((dir.join("truth.csv"), truth));
-    let json = serde_json::to_string_pretty(settings).map_err(|e| e.to_string())? + "\n";
+    // A JSON value (string keys only) always serialises.
+    let json = serde_json::to_string_pretty(settings).expect("a JSON value serialises") + "\n";
     files.push((dir.join("render.json"), json.into_bytes()));
     Ok(files)
 }
@@ -171,9 +213,22 @@ mod tests {
         let mut img = GrayImage::filled(2, 2, 0.5);
         img.set(1, 1, f32::NAN);
         let e = encode_gray_png(&img, 8).unwrap_err();
-        assert!(e.contains("col 1, row 1"), "{e}");
+        assert!(
+            matches!(e, PngFailure::Level { col: 1, row: 1, value } if value.is_nan()),
+            "{e}"
+        );
         img.set(1, 1, 1.5);
-        assert!(encode_gray_png(&img, 8).is_err());
-        assert!(encode_gray_png(&GrayImage::filled(2, 2, 0.5), 12).is_err());
+        assert_eq!(
+            encode_gray_png(&img, 8),
+            Err(PngFailure::Level {
+                col: 1,
+                row: 1,
+                value: 1.5
+            })
+        );
+        assert_eq!(
+            encode_gray_png(&GrayImage::filled(2, 2, 0.5), 12),
+            Err(PngFailure::Bits(12))
+        );
     }
 }

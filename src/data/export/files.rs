@@ -1,5 +1,6 @@
 //! The tables, LIGGGHTS lines, JSON summary and printed report of `restitution export`.
 
+use super::FilesFailure;
 use super::lammps::{Friction, LammpsLaw};
 use super::run::VerifyRow;
 use crate::data::fmt_num;
@@ -29,18 +30,25 @@ fn d_mm(x: Option<f64>) -> String {
     x.map(|d| fmt_num(d * 1e3)).unwrap_or_else(|| "inf".into())
 }
 
-fn csv_err(e: impl std::fmt::Display) -> String {
-    format!("cannot render CSV: {e}")
+/// Writing CSV into memory cannot fail: the writer's only errors are I/O (none into a `Vec`) and
+/// records of unequal length (each has the header's by construction); the fields are Rust
+/// strings, so the bytes are UTF-8.
+const IN_MEMORY: &str = "writing CSV into memory cannot fail";
+
+fn csv_text(w: csv::Writer<Vec<u8>>) -> String {
+    String::from_utf8(w.into_inner().expect(IN_MEMORY)).expect(IN_MEMORY)
 }
 
 /// constant_e.csv: per pair the best constant e, its deviations, and the engine inputs that
 /// produce it. Empty cells: the engine cannot be asked for that e (see the column's note in the
 /// README).
-pub fn constant_e_csv(tr: &Translation, inputs: &[ConstantEInputs]) -> Result<String, String> {
-    let constant = tr
-        .constant
-        .as_ref()
-        .ok_or("constant e needs a speed range")?;
+pub fn constant_e_csv(
+    tr: &Translation,
+    inputs: &[ConstantEInputs],
+) -> Result<String, FilesFailure> {
+    let constant = tr.constant.as_ref().ok_or(FilesFailure::NeedsSpeedRange(
+        "constant e needs a speed range",
+    ))?;
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record([
         "pair",
@@ -58,7 +66,7 @@ pub fn constant_e_csv(tr: &Translation, inputs: &[ConstantEInputs]) -> Result<St
         "liggghts_e",
         "liggghts_e_if_given_e_mean",
     ])
-    .map_err(csv_err)?;
+    .expect(IN_MEMORY);
     for ((pair, c), inp) in tr.pairs.iter().zip(constant).zip(inputs) {
         w.write_record([
             pair.label(),
@@ -76,18 +84,21 @@ pub fn constant_e_csv(tr: &Translation, inputs: &[ConstantEInputs]) -> Result<St
             opt_cell(inp.liggghts_e),
             fmt_num(inp.liggghts_e_if_given_e),
         ])
-        .map_err(csv_err)?;
+        .expect(IN_MEMORY);
     }
-    String::from_utf8(w.into_inner().map_err(csv_err)?).map_err(csv_err)
+    Ok(csv_text(w))
 }
 
 /// table.csv: e of the fitted curve per pair on the speed grid (event-driven codes interpolate
 /// it; linear in ln v is what the reported interpolation error assumes).
-pub fn table_csv(tr: &Translation) -> Result<String, String> {
-    let t = tr.table.as_ref().ok_or("a table needs a speed range")?;
+pub fn table_csv(tr: &Translation) -> Result<String, FilesFailure> {
+    let t = tr
+        .table
+        .as_ref()
+        .ok_or(FilesFailure::NeedsSpeedRange("a table needs a speed range"))?;
     let mut w = csv::Writer::from_writer(Vec::new());
     w.write_record(["pair", "d1_mm", "d2_mm", "v_n_m_s", "e"])
-        .map_err(csv_err)?;
+        .expect(IN_MEMORY);
     for (p, pair) in tr.pairs.iter().enumerate() {
         for (v, e) in t.v_m_s.iter().zip(&t.e[p]) {
             w.write_record([
@@ -97,10 +108,10 @@ pub fn table_csv(tr: &Translation) -> Result<String, String> {
                 fmt_num(*v),
                 fmt_num(*e),
             ])
-            .map_err(csv_err)?;
+            .expect(IN_MEMORY);
         }
     }
-    String::from_utf8(w.into_inner().map_err(csv_err)?).map_err(csv_err)
+    Ok(csv_text(w))
 }
 
 /// liggghts.in: material properties for LIGGGHTS's Hertz model giving the constant e of each

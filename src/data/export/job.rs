@@ -9,8 +9,8 @@ use super::lammps::Friction;
 use super::plan::{self, EngineKind, LawChoice};
 use super::run::{self, VerifyRow};
 use super::{
-    FitParamsFile, WaltonParams, parse_params_json, parse_walton_json, read_params_json,
-    read_walton_json, report,
+    FilesFailure, FitParamsFile, RunFailure, WaltonParams, parse_params_json, parse_walton_json,
+    read_params_json, read_walton_json, report,
 };
 use crate::contact::Material;
 pub use crate::data::ArgStyle;
@@ -39,9 +39,12 @@ pub enum ExportError {
     /// An input document (params.json, walton.json) at fault: its name, and where it can be.
     #[error(transparent)]
     Data(#[from] super::super::DataError),
+    /// The engine files could not be built for the law (`law`: the law as the user gave it).
+    #[error("{law}: {kind}")]
+    Files { law: String, kind: FilesFailure },
     /// The engine could not be run for the round trip, or its output could not be read.
-    #[error("{0}")]
-    Engine(String),
+    #[error(transparent)]
+    Engine(#[from] RunFailure),
     /// LAMMPS ran but its e differs from the toolkit's; `table` shows every collision.
     #[error("{message}")]
     Verify { message: String, table: String },
@@ -281,14 +284,14 @@ pub struct Exported {
     pub verify_table: Option<String>,
 }
 
-fn positive(name: &str, x: f64) -> Result<f64, String> {
+fn positive(name: &str, x: f64) -> Result<f64, ExportError> {
     if x.is_finite() && x > 0.0 {
         Ok(x)
     } else {
-        Err(format!(
+        Err(ExportError::Input(format!(
             "{name} {}: expected a finite number > 0",
             fmt_num(x)
-        ))
+        )))
     }
 }
 
@@ -391,7 +394,10 @@ pub fn export(law: &FittedLaw, o: &ExportOptions) -> Result<Exported, ExportErro
         &speeds,
         &law.source,
     )
-    .map_err(|e| format!("{}: {e}", law.shown))?;
+    .map_err(|kind| ExportError::Files {
+        law: law.shown.clone(),
+        kind,
+    })?;
     let mut outputs = plan.outputs.clone();
     #[cfg(feature = "plot")]
     if tr.request.range.is_some() {
@@ -403,7 +409,7 @@ pub fn export(law: &FittedLaw, o: &ExportOptions) -> Result<Exported, ExportErro
     }
     let verify_rows = match (&plan.lammps_files, o.verify) {
         (Some(lf), true) => {
-            let rows = run::verify_files(&tr, lf, &LADDER).map_err(ExportError::Engine)?;
+            let rows = run::verify_files(&tr, lf, &LADDER)?;
             let worst = rows
                 .iter()
                 .map(|r| r.difference().abs())

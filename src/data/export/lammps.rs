@@ -2,6 +2,7 @@
 //! granular`), collide.in (head-on collisions that print e), and the round trip that runs `lmp`
 //! on them (docs/physics.md §9).
 
+use super::FilesFailure;
 use crate::data::fmt_num;
 use crate::dem::engines::lammps_tsuji_alpha;
 use crate::dem::translate::{Collision, EngineLaw, LammpsViscoelastic, Translation};
@@ -102,7 +103,7 @@ pub fn lammps_files(
     friction: Option<&Friction>,
     speeds: &[f64],
     source: &str,
-) -> Result<LammpsFiles, String> {
+) -> Result<LammpsFiles, FilesFailure> {
     let scene = &tr.request.scene;
     let m = scene.material;
     let rule = tr.request.curve.rule;
@@ -234,20 +235,19 @@ pub fn lammps_files(
             for &v in speeds {
                 let kappa = pair.contact.kappa(*eta, v);
                 if kappa.is_nan() || kappa > 1000.0 {
-                    return Err(format!(
-                        "pair {} at {} m/s: dimensionless damping kappa = {} (eta = {} kg/(s m)); beyond 1000 the collision is overdamped (e < 1e-10): lower eta or the speed",
-                        pair.label(),
-                        fmt_num(v),
-                        fmt_num(kappa),
-                        fmt_num(*eta)
-                    ));
+                    return Err(FilesFailure::Overdamped {
+                        pair: pair.label(),
+                        v_m_s: v,
+                        kappa,
+                        eta: *eta,
+                    });
                 }
             }
         }
     }
     let collisions = tr
         .collisions(&law.engine_law(), speeds)
-        .map_err(|e| format!("cannot predict the collisions: {e}"))?;
+        .map_err(FilesFailure::Collisions)?;
     let collide_in = collide_input(tr, &collisions, n_types)?;
     Ok(LammpsFiles {
         in_restitution: f,
@@ -261,7 +261,7 @@ fn collide_input(
     tr: &Translation,
     collisions: &[Collision],
     n_types: usize,
-) -> Result<String, String> {
+) -> Result<String, FilesFailure> {
     let scene = &tr.request.scene;
     let d_max = scene.diameters_m.iter().cloned().fold(0.0, f64::max);
     let tc_min = collisions
@@ -273,15 +273,16 @@ fn collide_input(
         .map(|c| c.separation_time_s)
         .fold(0.0, f64::max);
     if !(tc_min.is_finite() && tc_min > 0.0) {
-        return Err("no collision to write".into());
+        return Err(FilesFailure::NoCollision);
     }
     // One run steps through the longest collision at the shortest one's step: beyond a ratio of
     // 1000 that is over 1e7 steps at the default N (hours), so the speeds (or sizes) must be
     // split over several exports.
     if t_sep_max / tc_min > 1000.0 {
-        return Err(format!(
-            "collide.in: contacts last from {tc_min:.3e} s to {t_sep_max:.3e} s, too wide for one run at the shortest one's step; give --speeds closer together"
-        ));
+        return Err(FilesFailure::ContactsTooWide {
+            shortest_s: tc_min,
+            longest_s: t_sep_max,
+        });
     }
     // The contact starts 10 to 11 steps after the run starts (see the gaps below); 20% beyond the
     // latest separation leaves every pair apart at the end, which collide.in prints as a gap.

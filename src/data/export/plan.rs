@@ -1,6 +1,7 @@
 //! Which files an export writes and what they carry: the engine's law (exact, closest
 //! viscoelastic or constant e), the LAMMPS inputs, the constant-e and table files.
 
+use super::FilesFailure;
 use super::files::{self, Summary};
 use super::lammps::{self, Friction, LammpsFiles, LammpsLaw};
 use crate::data::fmt_num;
@@ -61,7 +62,7 @@ pub fn plan(
     friction: Option<&Friction>,
     speeds: &[f64],
     source: &str,
-) -> Result<Plan, String> {
+) -> Result<Plan, FilesFailure> {
     let rule = tr.request.curve.rule;
     let needs_constant = engine == EngineKind::ConstantE
         || (engine == EngineKind::Lammps && law != LawChoice::Viscoelastic);
@@ -70,14 +71,14 @@ pub fn plan(
             c.iter()
                 .map(|x| constant_e_inputs(x.e_mean, rule))
                 .collect::<Result<Vec<_>, _>>()
-                .map_err(|e| format!("constant e: {e}"))?,
+                .map_err(FilesFailure::ConstantE)?,
         ),
         _ => None,
     };
-    let tsuji_law = |note: String| -> Result<LammpsLaw, String> {
-        let inputs = const_inputs
-            .as_ref()
-            .ok_or("a constant e needs the scene's speeds (--v-range)")?;
+    let tsuji_law = |note: String| -> Result<LammpsLaw, FilesFailure> {
+        let inputs = const_inputs.as_ref().ok_or(FilesFailure::NeedsSpeedRange(
+            "a constant e needs the scene's speeds (--v-range)",
+        ))?;
         Ok(LammpsLaw::Tsuji {
             // The polynomial cannot ask for less damping than at cor = 1 (e above 0.99958):
             // then cor = 1, and collide.in's expected e says what LAMMPS gives instead.

@@ -1,6 +1,7 @@
 //! The LAMMPS round trip: runs `lmp` on collide.in over a ladder of time steps, averages the
 //! phases, extrapolates to a zero step and compares with the toolkit (docs/physics.md §9).
 
+use super::RunFailure;
 use super::lammps::LammpsFiles;
 use crate::data::fmt_num;
 use crate::data::write_all_atomic;
@@ -34,7 +35,7 @@ impl VerifyRow {
 }
 
 /// Runs `lmp` on DIR/collide.in with `-var steps N`, returning its standard output.
-pub fn run_lmp(dir: &Path, steps: u32) -> Result<String, String> {
+pub fn run_lmp(dir: &Path, steps: u32) -> Result<String, RunFailure> {
     let out = Command::new("lmp")
         .current_dir(dir)
         .args([
@@ -50,33 +51,31 @@ pub fn run_lmp(dir: &Path, steps: u32) -> Result<String, String> {
         .output()
         .map_err(|e| {
             if e.kind() == std::io::ErrorKind::NotFound {
-                "lmp (LAMMPS) is not on PATH: install it (Debian/Ubuntu: apt-get install lammps) \
-                 or run collide.in yourself"
-                    .to_string()
+                RunFailure::NotOnPath
             } else {
-                format!("cannot run lmp: {e}")
+                RunFailure::CannotStart(e.to_string())
             }
         })?;
     let text = String::from_utf8_lossy(&out.stdout).to_string();
     if !out.status.success() {
-        let msg = text
+        let error_line = text
             .lines()
             .chain(String::from_utf8_lossy(&out.stderr).lines())
             .find(|l| l.contains("ERROR"))
             .unwrap_or("no ERROR line")
             .to_string();
-        return Err(format!(
-            "lmp failed on {}/collide.in ({}): {msg}",
-            dir.display(),
-            out.status
-        ));
+        return Err(RunFailure::Failed {
+            dir: dir.display().to_string(),
+            status: out.status.to_string(),
+            error_line,
+        });
     }
     Ok(text)
 }
 
 /// The phase means per (pair, speed) from collide.in's output, checking that every collision
 /// ended (positive gap) and printed a number.
-pub fn parse_collide_output(text: &str) -> Result<BTreeMap<(String, String), f64>, String> {
+pub fn parse_collide_output(text: &str) -> Result<BTreeMap<(String, String), f64>, RunFailure> {
     let mut sums: BTreeMap<(String, String), (f64, usize)> = BTreeMap::new();
     for line in text.lines() {
         let Some(rest) = line.strip_prefix("restitution-e ") else {
@@ -87,23 +86,28 @@ pub fn parse_collide_output(text: &str) -> Result<BTreeMap<(String, String), f64
             .filter_map(|w| w.split_once('='))
             .collect();
         let get = |k: &str| {
-            kv.get(k)
-                .copied()
-                .ok_or_else(|| format!("collide.in output line without '{k}': {line}"))
+            kv.get(k).copied().ok_or_else(|| RunFailure::MissingField {
+                field: k.to_string(),
+                line: line.to_string(),
+            })
         };
-        let e: f64 = get("e")?
-            .parse()
-            .map_err(|_| format!("collide.in printed a non-number e: {line}"))?;
-        let gap: f64 = get("gap_m")?
-            .parse()
-            .map_err(|_| format!("collide.in printed a non-number gap: {line}"))?;
+        let not_a_number = |what| RunFailure::NotANumber {
+            what,
+            line: line.to_string(),
+        };
+        let e: f64 = get("e")?.parse().map_err(|_| not_a_number("e"))?;
+        let gap: f64 = get("gap_m")?.parse().map_err(|_| not_a_number("gap"))?;
         if !e.is_finite() {
-            return Err(format!("collide.in printed e = {e}: {line}"));
+            return Err(RunFailure::NonFiniteE {
+                e,
+                line: line.to_string(),
+            });
         }
         if gap.is_nan() || gap <= 0.0 {
-            return Err(format!(
-                "a collision had not ended when the run stopped (gap {gap} m): {line}"
-            ));
+            return Err(RunFailure::NotEnded {
+                gap_m: gap,
+                line: line.to_string(),
+            });
         }
         let entry = sums
             .entry((get("pair")?.to_string(), get("v_m_s")?.to_string()))
@@ -112,7 +116,7 @@ pub fn parse_collide_output(text: &str) -> Result<BTreeMap<(String, String), f64
         entry.1 += 1;
     }
     if sums.is_empty() {
-        return Err("collide.in printed no restitution-e lines".into());
+        return Err(RunFailure::NoOutput);
     }
     Ok(sums
         .into_iter()
@@ -127,9 +131,9 @@ pub fn verify(
     tr: &Translation,
     collisions: &[Collision],
     ladder: &[u32],
-) -> Result<Vec<VerifyRow>, String> {
+) -> Result<Vec<VerifyRow>, RunFailure> {
     if ladder.len() < 2 || ladder.windows(2).any(|w| w[1] != 2 * w[0]) {
-        return Err("the step ladder needs at least two rungs, each twice the last".into());
+        return Err(RunFailure::Ladder);
     }
     let mut runs = Vec::new();
     for &n in ladder {
@@ -140,12 +144,12 @@ pub fn verify(
         let key = (tr.pairs[col.pair].label(), fmt_num(col.v_m_s));
         let mut rungs = Vec::new();
         for (n, means) in &runs {
-            let e = means.get(&key).ok_or_else(|| {
-                format!(
-                    "collide.in printed nothing for pair {} at {} m/s",
-                    key.0, key.1
-                )
-            })?;
+            let e = means
+                .get(&key)
+                .ok_or_else(|| RunFailure::MissingCollision {
+                    pair: key.0.clone(),
+                    v_m_s: key.1.clone(),
+                })?;
             rungs.push((*n, *e));
         }
         let k = rungs.len();
@@ -173,7 +177,7 @@ pub fn verify_files(
     tr: &Translation,
     lf: &LammpsFiles,
     ladder: &[u32],
-) -> Result<Vec<VerifyRow>, String> {
+) -> Result<Vec<VerifyRow>, RunFailure> {
     // Unique per process and call: verifications may run concurrently (threads, tests).
     static CALLS: AtomicUsize = AtomicUsize::new(0);
     let dir = std::env::temp_dir().join(format!(
@@ -181,8 +185,12 @@ pub fn verify_files(
         std::process::id(),
         CALLS.fetch_add(1, Ordering::SeqCst)
     ));
-    std::fs::create_dir_all(&dir)
-        .map_err(|e| format!("{}: cannot create the directory: {e}", dir.display()))?;
+    let scratch_failure = |action, e: std::io::Error| RunFailure::Scratch {
+        dir: dir.display().to_string(),
+        action,
+        reason: e.to_string(),
+    };
+    std::fs::create_dir_all(&dir).map_err(|e| scratch_failure("create the directory", e))?;
     let scratch = [
         (
             dir.join("in.restitution"),
@@ -191,7 +199,7 @@ pub fn verify_files(
         (dir.join("collide.in"), lf.collide_in.clone().into_bytes()),
     ];
     let result = write_all_atomic(&scratch)
-        .map_err(|e| format!("{}: cannot write: {e}", dir.display()))
+        .map_err(|e| scratch_failure("write", e))
         .and_then(|_| verify(&dir, tr, &lf.collisions, ladder));
     let _ = std::fs::remove_dir_all(&dir);
     result
@@ -208,14 +216,18 @@ mod tests {
                   restitution-e-mean pair=1-2 v_m_s=2 e=0.6 toolkit_e=0.6\n";
         let m = parse_collide_output(ok).unwrap();
         assert_eq!(m[&("1-2".to_string(), "2".to_string())], 0.6);
-        for bad in [
+        let bad = [
             "restitution-e pair=1-1 v_m_s=2 phase=0 e=0.5 gap_m=-1e-6",
             "restitution-e pair=1-1 v_m_s=2 phase=0 e=nan gap_m=1e-6",
             "restitution-e pair=1-1 v_m_s=2 phase=0 e=x gap_m=1e-6",
             "restitution-e pair=1-1 v_m_s=2 phase=0 gap_m=1e-6",
             "nothing here",
-        ] {
-            assert!(parse_collide_output(bad).is_err(), "{bad}");
-        }
+        ]
+        .map(|text| parse_collide_output(text).unwrap_err());
+        assert!(matches!(&bad[0], RunFailure::NotEnded { gap_m, .. } if *gap_m == -1e-6));
+        assert!(matches!(&bad[1], RunFailure::NonFiniteE { e, .. } if e.is_nan()));
+        assert!(matches!(&bad[2], RunFailure::NotANumber { what: "e", .. }));
+        assert!(matches!(&bad[3], RunFailure::MissingField { field, .. } if field == "e"));
+        assert_eq!(bad[4], RunFailure::NoOutput);
     }
 }

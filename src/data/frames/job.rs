@@ -3,7 +3,7 @@
 //! and the files of `--out` (with one overlay figure per collision).
 
 use super::{collision_id, collisions_csv, detect_dir, detections_csv, spins_csv, tracks_csv};
-use crate::data::{ArgStyle, DataError, DataFailure, fmt_num};
+use crate::data::{ArgStyle, DataError, fmt_num};
 use crate::frames::detect::DetectSettings;
 use crate::frames::spin::Spin;
 use crate::frames::track::{CollisionResult, TrackError, TrackSettings, assemble};
@@ -51,17 +51,17 @@ pub struct TrackRequest {
 
 impl TrackRequest {
     /// The detector's and the tracker's settings, or a one-line error naming the argument.
-    pub fn settings(&self) -> Result<(DetectSettings, TrackSettings), String> {
+    pub fn settings(&self) -> Result<(DetectSettings, TrackSettings), TrackJobError> {
         let name = |k: &str| self.style.name(k);
         let positive = |k: &str, v: f64| {
             if v.is_finite() && v > 0.0 {
                 Ok(v)
             } else {
-                Err(format!(
+                Err(TrackJobError::Input(format!(
                     "{} {}: expected a positive number",
                     name(k),
                     fmt_num(v)
-                ))
+                )))
             }
         };
         // Ranges wide enough for any camera and sphere, narrow enough that no time, position,
@@ -71,13 +71,13 @@ impl TrackRequest {
             if (lo..=hi).contains(&v) {
                 Ok(v)
             } else {
-                Err(format!(
+                Err(TrackJobError::Input(format!(
                     "{} {}: expected {} to {} {unit}",
                     name(k),
                     fmt_num(v),
                     fmt_num(lo),
                     fmt_num(hi)
-                ))
+                )))
             }
         };
         let fps = within(
@@ -96,14 +96,19 @@ impl TrackRequest {
             None => None,
             Some([d1]) => Some([d(*d1)?; 2]),
             Some([d1, d2]) => Some([d(*d1)?, d(*d2)?]),
-            Some(_) => return Err(format!("{} takes one or two diameters", name("d_mm"))),
+            Some(_) => {
+                return Err(TrackJobError::Input(format!(
+                    "{} takes one or two diameters",
+                    name("d_mm")
+                )));
+            }
         };
         if pixel_m.is_none() && d_m.is_none() {
-            return Err(format!(
+            return Err(TrackJobError::Input(format!(
                 "the scale is missing: give {} P (pixel size in the object plane, m) or {} D1[,D2] (the diameters set it)",
                 name("pixel_m"),
                 name("d_mm")
-            ));
+            )));
         }
         let mut detect = DetectSettings::default();
         if let (Some(d), Some(p)) = (d_m, pixel_m) {
@@ -127,7 +132,7 @@ pub fn track_dirs(
     request: &TrackRequest,
     on_frame: &(dyn Fn() + Sync),
 ) -> Result<Vec<CollisionResult>, TrackJobError> {
-    let (detect, settings) = request.settings().map_err(TrackJobError::Input)?;
+    let (detect, settings) = request.settings()?;
     if dirs.is_empty() {
         return Err(TrackJobError::Input("no directory of frames given".into()));
     }
@@ -196,14 +201,8 @@ pub fn track_files(results: &[CollisionResult]) -> Result<Vec<(String, Vec<u8>)>
             _ => closest(r),
         };
         let f = &r.frames[r.track_frames[row]];
-        let img = read_gray(std::path::Path::new(&f.meta.name))?;
-        let png = encode_png(&img).map_err(|message| DataError {
-            path: f.meta.name.clone(),
-            line: None,
-            column: None,
-            kind: DataFailure::Format,
-            message,
-        })?;
+        let frame = std::path::Path::new(&f.meta.name);
+        let png = encode_png(frame, &read_gray(frame)?)?;
         let title = format!(
             "{}: frame {} (t = {} s)",
             r.id,

@@ -190,12 +190,12 @@ pub const CSV_HEADER: [&str; 19] = [
 ];
 
 /// `params.csv`: one row per model and parameter (derived ones too), full precision; the fit's
-/// warnings joined by "; " in the last column (empty for a clean fit). Writing to memory cannot
-/// fail short of a bug in the csv crate; such a failure is returned, named.
-pub fn to_csv(_ctx: &ReportContext, set: &FitSet) -> Result<String, String> {
+/// warnings joined by "; " in the last column (empty for a clean fit). Writing CSV into memory
+/// cannot fail: the writer's only errors are I/O (none into a `Vec`) and records of unequal
+/// length (each has the header's 19 by its type), and Rust strings in give UTF-8 out.
+pub fn to_csv(_ctx: &ReportContext, set: &FitSet) -> String {
     let mut w = csv::Writer::from_writer(Vec::new());
     let o = |x: Option<f64>| x.filter(|v| v.is_finite()).map(fmt_num).unwrap_or_default();
-    let fail = |e: csv::Error| format!("CSV writer failed in memory: {e}");
     let mut rows: Vec<[String; 19]> = Vec::new();
     for (i, f) in set.fits.iter().enumerate() {
         let row = set.comparison.as_ref().map(|c| &c.rows[i]);
@@ -223,12 +223,12 @@ pub fn to_csv(_ctx: &ReportContext, set: &FitSet) -> Result<String, String> {
             ]);
         }
     }
-    let written = w
-        .write_record(CSV_HEADER)
-        .and_then(|()| rows.iter().try_for_each(|r| w.write_record(r)))
-        .map_err(fail)
-        .and_then(|()| w.into_inner().map_err(|e| fail(e.into_error().into())));
-    String::from_utf8(written?).map_err(|e| format!("CSV writer produced invalid UTF-8: {e}"))
+    const IN_MEMORY: &str = "writing CSV into memory cannot fail";
+    w.write_record(CSV_HEADER).expect(IN_MEMORY);
+    for r in &rows {
+        w.write_record(r).expect(IN_MEMORY);
+    }
+    String::from_utf8(w.into_inner().expect(IN_MEMORY)).expect(IN_MEMORY)
 }
 
 #[cfg(test)]
@@ -260,7 +260,7 @@ mod tests {
             rule: ContactEnd::Overlap,
             vm_method: &VmMethod::Master,
         };
-        let text = to_csv(&ctx, &set).unwrap();
+        let text = to_csv(&ctx, &set);
         let mut r = csv::Reader::from_reader(text.as_bytes());
         let head: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
         assert_eq!(head, CSV_HEADER);

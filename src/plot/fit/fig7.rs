@@ -1,0 +1,214 @@
+//! `fig7.svg`: the paper's Fig. 7 with the fitted models.
+
+use super::{
+    Sample, colour, describe, draw_legend, draw_markers, log_points, log_ticks, short_value,
+    svg_err,
+};
+use crate::fit::dataset::{FitData, Group};
+use crate::fit::engine::FitSet;
+use crate::fit::models::{ModelKind, predict_e};
+use crate::fit::result::FitResult;
+use crate::models::viscoelastic::{ContactEnd, VmMethod};
+use crate::plot::{PlotError, PlotFailure};
+use plotters::prelude::*;
+
+/// The model's e along `vs` for a group's pair, dropping points the axes cannot show.
+fn curve(
+    f: &FitResult,
+    g: &Group,
+    data: &FitData,
+    vs: &[f64],
+    rule: ContactEnd,
+    method: &VmMethod,
+    y_range: (f64, f64),
+) -> Vec<(f64, f64)> {
+    let contact = data.contacts[g.indices[0]];
+    let p = f.best_fit_values();
+    vs.iter()
+        .filter_map(|&v| {
+            predict_e(f.model, &contact, v, &p, rule, method)
+                .ok()
+                .filter(|e| *e >= y_range.0 && *e <= y_range.1)
+                .map(|e| (v, e))
+        })
+        .collect()
+}
+
+/// `fig7.svg`: e against v_n on log-log axes. Data with error bars, one colour and marker per
+/// pair geometry; the fitted VM curve for each geometry (solid); the PM curve (black, dash-dot;
+/// one curve when every pair has the same V_Y, as identical spheres of one material do); the
+/// preferred model when it is neither of those (dashed, per geometry).
+pub fn fig7_svg(
+    data: &FitData,
+    set: &FitSet,
+    rule: ContactEnd,
+    method: &VmMethod,
+    title: &str,
+) -> Result<String, PlotError> {
+    draw_fig7(data, set, rule, method, title).map_err(PlotError::of("fig7.svg"))
+}
+
+fn draw_fig7(
+    data: &FitData,
+    set: &FitSet,
+    rule: ContactEnd,
+    method: &VmMethod,
+    title: &str,
+) -> Result<String, PlotFailure> {
+    let groups = data.groups();
+    let (mut vlo, mut vhi) = (f64::INFINITY, 0.0f64);
+    let (mut elo, mut ehi) = (f64::INFINITY, 0.0f64);
+    for (i, o) in data.obs.iter().enumerate() {
+        vlo = vlo.min(o.v_n_m_s);
+        vhi = vhi.max(o.v_n_m_s);
+        let s = o.e_err.unwrap_or(0.0);
+        ehi = ehi.max(o.e + s);
+        if o.e > 0.0 {
+            elo = elo.min(if o.e - s > 0.0 { o.e - s } else { o.e });
+        }
+        let _ = i;
+    }
+    let x_range = (vlo / 1.25, vhi * 1.25);
+    let ehi = ehi.max(1.0) * 1.03;
+    let elo = (elo / 1.05).clamp(1e-4, 0.99);
+    let y_range = (elo, ehi);
+    let vs = log_points(x_range.0, x_range.1, 240);
+
+    let find = |k: ModelKind| set.fits.iter().find(|f| f.model == k);
+    let preferred = set.comparison.as_ref().and_then(|c| c.preferred);
+    let tag = |k: ModelKind| {
+        if Some(k) == preferred {
+            " (preferred)"
+        } else {
+            ""
+        }
+    };
+    let data_key: Vec<(Sample, String)> = groups
+        .iter()
+        .enumerate()
+        .map(|(gi, g)| {
+            (
+                Sample::Marker(gi, colour(gi)),
+                format!("data, {}", g.label()),
+            )
+        })
+        .collect();
+    let mut legend: Vec<(Sample, String)> = Vec::new();
+    let combined = preferred
+        .filter(|k| !matches!(k, ModelKind::Vm | ModelKind::Pm))
+        .and_then(find);
+    if let Some(f) = find(ModelKind::Vm) {
+        legend.push((
+            Sample::Line(RGBColor(90, 90, 90), 2),
+            format!("VM{}, one per size: {}", tag(ModelKind::Vm), describe(f)),
+        ));
+    }
+    if let Some(f) = find(ModelKind::Pm) {
+        legend.push((
+            Sample::Dashed(BLACK, 2),
+            format!("PM{}: {}", tag(ModelKind::Pm), describe(f)),
+        ));
+    }
+    if let Some(f) = combined {
+        legend.push((
+            Sample::Dashed(RGBColor(90, 90, 90), 4),
+            format!(
+                "{} (preferred), one per size: {}",
+                f.model.name(),
+                describe(f)
+            ),
+        ));
+    }
+    let legend_rows = legend.len().max(data_key.len()) as u32;
+    let legend_h = 24 + legend_rows * 26;
+    let height = 640 + legend_h;
+
+    let mut buf = String::new();
+    {
+        let root = SVGBackend::with_string(&mut buf, (980, height)).into_drawing_area();
+        root.fill(&WHITE).map_err(svg_err)?;
+        let (top, bottom) = root.split_vertically(640);
+        let mut chart = ChartBuilder::on(&top)
+            .caption(title, ("sans-serif", 22))
+            .margin(14)
+            .x_label_area_size(58)
+            .y_label_area_size(78)
+            .build_cartesian_2d(
+                (x_range.0..x_range.1)
+                    .log_scale()
+                    .with_key_points(log_ticks(x_range.0, x_range.1)),
+                (y_range.0..y_range.1)
+                    .log_scale()
+                    .with_key_points(log_ticks(y_range.0, y_range.1)),
+            )
+            .map_err(svg_err)?;
+        chart
+            .configure_mesh()
+            .x_desc("normal impact speed v_n (m/s)")
+            .y_desc("coefficient of restitution e")
+            .axis_desc_style(("sans-serif", 20))
+            .label_style(("sans-serif", 16))
+            .x_label_formatter(&|v| short_value(*v))
+            .y_label_formatter(&|e| short_value(*e))
+            .bold_line_style(RGBColor(225, 225, 225))
+            .draw()
+            .map_err(svg_err)?;
+
+        // Model curves first, so the data stay on top.
+        if let Some(f) = find(ModelKind::Vm) {
+            for (gi, g) in groups.iter().enumerate() {
+                let pts = curve(f, g, data, &vs, rule, method, y_range);
+                chart
+                    .draw_series(LineSeries::new(pts, colour(gi).stroke_width(2)))
+                    .map_err(svg_err)?;
+            }
+        }
+        if let Some(f) = find(ModelKind::Pm) {
+            let mut seen: Vec<f64> = Vec::new();
+            for g in &groups {
+                let vy = data.contacts[g.indices[0]].yield_velocity_m_s(f.best_fit_values()[0]);
+                if seen.iter().any(|s| (s / vy - 1.0).abs() < 1e-9) {
+                    continue;
+                }
+                seen.push(vy);
+                let pts = curve(f, g, data, &vs, rule, method, y_range);
+                chart
+                    .draw_series(DashedLineSeries::new(pts, 10, 4, BLACK.stroke_width(2)))
+                    .map_err(svg_err)?;
+            }
+        }
+        if let Some(f) = combined {
+            for (gi, g) in groups.iter().enumerate() {
+                let pts = curve(f, g, data, &vs, rule, method, y_range);
+                chart
+                    .draw_series(DashedLineSeries::new(pts, 6, 5, colour(gi).stroke_width(4)))
+                    .map_err(svg_err)?;
+            }
+        }
+        // Data with error bars.
+        for (gi, g) in groups.iter().enumerate() {
+            let c = colour(gi);
+            chart
+                .draw_series(g.indices.iter().filter_map(|&i| {
+                    let o = data.obs[i];
+                    let s = o.e_err?;
+                    let lo = (o.e - s).max(y_range.0);
+                    let hi = (o.e + s).min(y_range.1);
+                    (o.e > 0.0).then(|| {
+                        ErrorBar::new_vertical(o.v_n_m_s, lo, o.e, hi, c.stroke_width(1), 6)
+                    })
+                }))
+                .map_err(svg_err)?;
+            let pts: Vec<(f64, f64)> = g
+                .indices
+                .iter()
+                .map(|&i| (data.obs[i].v_n_m_s, data.obs[i].e))
+                .filter(|p| p.1 > 0.0)
+                .collect();
+            draw_markers(&mut chart, &pts, gi, 4, c)?;
+        }
+        draw_legend(&bottom, &[(40, data_key), (260, legend)], 16)?;
+        root.present().map_err(svg_err)?;
+    }
+    Ok(buf)
+}
