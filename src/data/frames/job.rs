@@ -2,7 +2,9 @@
 //! alike: the checks of the request, detection of every directory, the tracks, the warnings,
 //! and the files of `--out` (with one overlay figure per collision).
 
-use super::{collision_id, collisions_csv, detect_dir, detections_csv, spins_csv, tracks_csv};
+use super::{collision_id, detect_dir};
+#[cfg(feature = "plot")]
+use super::{collisions_csv, detections_csv, spins_csv, tracks_csv};
 use crate::data::{ArgStyle, DataError, fmt_num};
 use crate::frames::detect::DetectSettings;
 use crate::frames::spin::Spin;
@@ -215,6 +217,7 @@ pub fn track_files(results: &[CollisionResult]) -> Result<Vec<(String, Vec<u8>)>
     Ok(files)
 }
 
+#[cfg(feature = "plot")]
 fn closest(r: &CollisionResult) -> usize {
     let d = |f: &crate::kinematics::Frame| (f.r1_m[0] - f.r2_m[0]).hypot(f.r1_m[1] - f.r2_m[1]);
     (0..r.tracks.len())
