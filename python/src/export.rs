@@ -65,6 +65,14 @@ fn input(e: ExportError) -> Failure {
     match e {
         ExportError::Input(m) => Failure::Input(m),
         ExportError::Data(d) => Failure::Data(d),
+        // A parameter or a scene outside the library's domain is the caller's input; a
+        // translation that failed on a valid law is numerical.
+        e @ ExportError::Law {
+            source:
+                restitution::Error::InvalidParameter { .. } | restitution::Error::OutOfRange { .. },
+            ..
+        } => Failure::Input(e.to_string()),
+        e @ ExportError::Law { .. } => Failure::Numerical(e.to_string()),
         // The law asks for files the engine cannot take (an overdamped pair, contacts too
         // different for one run): the caller's input.
         e @ ExportError::Files { .. } => Failure::Input(e.to_string()),

@@ -36,6 +36,13 @@ pub enum ExportError {
     /// A bad argument or combination of arguments: one line.
     #[error("{0}")]
     Input(String),
+    /// The library refused the law or the scene (a parameter outside its domain, a translation
+    /// that failed); `context` names the flag or the law it came from.
+    #[error("{}", with_context(context.as_deref(), source))]
+    Law {
+        context: Option<String>,
+        source: crate::Error,
+    },
     /// An input document (params.json, walton.json) at fault: its name, and where it can be.
     #[error(transparent)]
     Data(#[from] super::super::DataError),
@@ -52,6 +59,13 @@ pub enum ExportError {
     #[cfg(feature = "plot")]
     #[error(transparent)]
     Plot(#[from] crate::plot::PlotError),
+}
+
+fn with_context(context: Option<&str>, source: &crate::Error) -> String {
+    match context {
+        Some(c) => format!("{c}: {source}"),
+        None => source.to_string(),
+    }
 }
 
 impl From<String> for ExportError {
@@ -167,7 +181,10 @@ impl FittedLaw {
             params.push(positive(name, x)?);
         }
         let curve = FittedCurve::new(kind, params, contact_end.unwrap_or(ContactEnd::Overlap))
-            .map_err(|e| e.to_string())?;
+            .map_err(|source| ExportError::Law {
+                context: None,
+                source,
+            })?;
         Ok(FittedLaw {
             curve,
             material,
@@ -368,7 +385,10 @@ pub fn export(law: &FittedLaw, o: &ExportOptions) -> Result<Exported, ExportErro
         sizes_mm.iter().map(|d| d * 1e-3).collect(),
         o.wall,
     )
-    .map_err(|e| format!("{}: {e}", name("d_mm")))?;
+    .map_err(|source| ExportError::Law {
+        context: Some(name("d_mm")),
+        source,
+    })?;
     let tr = Translation::new(Request {
         curve: law.curve.clone(),
         scene,
@@ -377,7 +397,10 @@ pub fn export(law: &FittedLaw, o: &ExportOptions) -> Result<Exported, ExportErro
         table_points: o.table_points,
         tolerance: o.tolerance,
     })
-    .map_err(|e| format!("{}: {e}", law.shown))?;
+    .map_err(|source| ExportError::Law {
+        context: Some(law.shown.clone()),
+        source,
+    })?;
     let speeds: Vec<f64> = if o.speeds_m_s.is_empty() {
         plan::default_speeds(o.v_range)
     } else {
