@@ -17,7 +17,7 @@ fn track(r_px: f64, d_mm: f64, pixel_m: Option<f64>) -> (CollisionResult, common
                     number: *n,
                     name: format!("f{n}.png"),
                 },
-                detect_frame(&sc.render(), &DetectSettings::default()).map_err(|e| e.to_string()),
+                detect_frame(&sc.render(), &DetectSettings::default()).map_err(Into::into),
             )
         })
         .collect();

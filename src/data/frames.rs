@@ -9,7 +9,7 @@ use super::tracks::{CollisionTrack, write_tracks};
 use super::{DataError, fmt_num};
 use crate::frames::detect::{DetectSettings, detect_frame};
 use crate::frames::spin::Spin;
-use crate::frames::track::{CollisionResult, FrameMeta, FrameOutcome, SphereObs};
+use crate::frames::track::{CollisionResult, FrameMeta, FrameOutcome, FrameProblem, SphereObs};
 use rayon::prelude::*;
 use serde_json::{Value, json};
 use std::path::Path;
@@ -44,8 +44,8 @@ pub fn detect_dir(
                 name: f.path.display().to_string(),
             };
             let res = read_gray(&f.path)
-                .map_err(|e| e.message)
-                .and_then(|img| detect_frame(&img, settings).map_err(|e| e.to_string()));
+                .map_err(|e| FrameProblem::Unreadable(e.message))
+                .and_then(|img| detect_frame(&img, settings).map_err(FrameProblem::Detect));
             on_frame();
             (meta, res)
         })

@@ -68,34 +68,16 @@ pub struct FrameDetection {
 }
 
 /// Why a frame gave nothing usable.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum DetectError {
+    #[error("{0}")]
     Coarse(CoarseError),
     /// More than two sphere-sized blobs (or maxima): not a two-sphere frame.
-    TooManyBlobs {
-        n: usize,
-    },
+    #[error("{n} sphere-sized blobs where at most 2 spheres were expected")]
+    TooManyBlobs { n: usize },
     /// Seeds were found but no circle could be fitted to any.
-    NoFit {
-        reasons: Vec<String>,
-    },
-}
-
-impl std::fmt::Display for DetectError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            DetectError::Coarse(e) => write!(f, "{e}"),
-            DetectError::TooManyBlobs { n } => {
-                write!(
-                    f,
-                    "{n} sphere-sized blobs where at most 2 spheres were expected"
-                )
-            }
-            DetectError::NoFit { reasons } => {
-                write!(f, "no sphere could be fitted: {}", reasons.join("; "))
-            }
-        }
-    }
+    #[error("no sphere could be fitted: {}", reasons.join("; "))]
+    NoFit { reasons: Vec<String> },
 }
 
 /// Settings of the detector.

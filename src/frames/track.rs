@@ -28,7 +28,18 @@ pub struct FrameMeta {
 }
 
 /// A frame and what its detection gave (`Err`: the frame's problem).
-pub type FrameOutcome = (FrameMeta, Result<FrameDetection, String>);
+pub type FrameOutcome = (FrameMeta, Result<FrameDetection, FrameProblem>);
+
+/// Why a frame gave no spheres: the file could not be read as an image, or the detector found
+/// none it could fit. Either leaves the frame out (or stops a strict run), named in the report.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum FrameProblem {
+    /// The reader's message (the file's name is the frame's, given beside it).
+    #[error("{0}")]
+    Unreadable(String),
+    #[error("{0}")]
+    Detect(#[from] super::detect::DetectError),
+}
 
 /// Settings of the assembly.
 #[derive(Debug, Clone, PartialEq)]
@@ -210,7 +221,7 @@ pub fn assemble(
                 let note = (!d.left_out.is_empty()).then(|| d.left_out.join("; "));
                 (obs, note)
             }
-            Err(e) => (Vec::new(), Some(e)),
+            Err(e) => (Vec::new(), Some(e.to_string())),
         };
         if obs.is_empty() {
             let why = note.clone().unwrap_or_default();
