@@ -4,7 +4,8 @@
 #    collisions at 1.5-2.5 m/s, incidences 5-80 degrees, truth beta_0 = 0.5, mu_0 = 0.175) through
 #    simulate -> kinematics --fixed-gravity -> walton fit (500 bootstrap resamples): how often the
 #    95% intervals cover the truth, and the mean of (estimate - truth) / stderr.
-# 2. Fixed-gravity against free fits: the median |e - e_true| over 1000 simulated collisions.
+# 2. Fixed-gravity against free fits: the median |e - e_true| over 1000 simulated collisions, and
+#    for each the standardised errors of e and the momentum-check scatter against its predictions.
 # Output: reports/kinematics/chain_coverage.txt. Deterministic (every step is seeded).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -71,6 +72,21 @@ free, fixed = median_error("free"), median_error("fixed")
 print(f"Fixed-gravity against free fits on the {len(both)} of 1000 simulated collisions (seed 3) "
       f"both measure: median |e - e_true| {fixed:.4f} against {free:.4f}, {free / fixed:.2f} times "
       f"smaller (fixed gravity alone also measures {len(e['fixed']) - len(both)} more)")
+# The error estimates: standardised errors (e - e_true)/e_err, and the momentum check (pure
+# measurement error) against what the fits' covariance (v_err_m_s) and Eq. (8) with the true s
+# (eq8_dv_m_s) predict, as the rms of the ratios over both components.
+def rms(v):
+    return (sum(x * x for x in v) / len(v)) ** 0.5
+for fits in ("free", "fixed"):
+    k = rows(f"{root}/g_{fits}/kinematics.csv")
+    z = [(float(r["e"]) - truth[r["collision"]]) / float(r["e_err"]) for r in k]
+    m = sum(z) / len(z)
+    sd = (sum((x - m) ** 2 for x in z) / (len(z) - 1)) ** 0.5
+    dv = [(r, c) for r in k for c in ("momentum_dvx_m_s", "momentum_dvy_m_s")]
+    cov = rms([float(r[c]) / float(r["v_err_m_s"]) for r, c in dv])
+    eq8 = rms([float(r[c]) / float(r["eq8_dv_m_s"]) for r, c in dv])
+    print(f"{fits} fits, {len(k)} collisions: (e - e_true)/e_err has sd {sd:.2f} and mean {m:+.2f}; "
+          f"momentum-check scatter {cov:.2f} times the covariance's prediction, {eq8:.2f} times Eq. (8)'s")
 PY
 {
     echo "# made by scripts/chain_coverage.sh"

@@ -70,3 +70,70 @@ fn an_unmeasured_spin_is_named_not_silently_zero() {
     // And it matters: sphere 2's post-collision spin enters beta.
     assert_ne!(beta(&out_full), beta(&out_blank));
 }
+
+/// Runs `kinematics` on the committed track with extra flags; (exit ok, stdout, stderr).
+fn kinematics_with(tag: &str, flags: &[&str]) -> (bool, String, String) {
+    let dir = std::env::temp_dir().join(format!("restitution-kinf-{tag}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("tracks.csv");
+    std::fs::write(&path, tracks()).unwrap();
+    let out = dir.join("out");
+    let o = Command::new(bin())
+        .args(["kinematics", path.to_str().unwrap(), "--material", "nylon"])
+        .args(["--out", out.to_str().unwrap()])
+        .args(flags)
+        .output()
+        .unwrap();
+    let wrote = out.exists();
+    let _ = std::fs::remove_dir_all(&dir);
+    let ok = o.status.success();
+    assert_eq!(
+        ok, wrote,
+        "output written exactly when the command succeeds"
+    );
+    (
+        ok,
+        String::from_utf8(o.stdout).unwrap(),
+        String::from_utf8(o.stderr).unwrap(),
+    )
+}
+
+#[test]
+fn the_subpixel_size_is_checked_given_or_derived() {
+    // Eq. (8)'s subpixel, given (--subpixel-m) or derived (--fov-m / --pixels-x /
+    // --subpixel-expansion), must lie in [1e-12, 1] m, as track's pixel size: a subnormal
+    // --fov-m gave a subpixel of 0 m and "inf subpixels" on stdout.
+    for (tag, flags, named) in [
+        (
+            "sub0",
+            &["--subpixel-m", "5e-324"][..],
+            "--subpixel-m 5e-324",
+        ),
+        ("sub1", &["--subpixel-m", "9e-13"][..], "--subpixel-m 9e-13"),
+        ("sub2", &["--subpixel-m", "1.5"][..], "--subpixel-m 1.5"),
+        ("fov0", &["--fov-m", "5e-324"][..], "--fov-m 5e-324"),
+        (
+            "fov1",
+            &["--fov-m", "1e300", "--subpixel-expansion", "1e-300"][..],
+            "--subpixel-expansion 1e-300",
+        ),
+    ] {
+        let (ok, stdout, stderr) = kinematics_with(tag, flags);
+        assert!(!ok && stdout.is_empty(), "{flags:?}: {stdout}");
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{flags:?}: {stderr}");
+        assert!(
+            stderr.contains(named) && stderr.contains("[1e-12, 1] m"),
+            "{flags:?}: {stderr}"
+        );
+    }
+    // The ends of the range are sizes like any other: a number of subpixels, finite.
+    for (tag, p) in [("lo", "1e-12"), ("hi", "1")] {
+        let (ok, stdout, stderr) = kinematics_with(tag, &["--subpixel-m", p]);
+        assert!(ok, "--subpixel-m {p}: {stderr}");
+        let last = stdout.lines().last().unwrap();
+        assert!(
+            last.contains(&format!("subpixels of {p} m")) && !last.contains("inf"),
+            "{last}"
+        );
+    }
+}

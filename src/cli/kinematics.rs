@@ -52,7 +52,7 @@ pub struct Args {
     /// Eq. (8): accuracy of a centre in subpixels
     #[arg(long = "s-subpixels", value_name = "S", default_value_t = Camera::PAPER.s_subpixels)]
     s_subpixels: f64,
-    /// Eq. (8): subpixel size in the object plane, m (default: from the field of view)
+    /// Eq. (8): subpixel size in the object plane, 1e-12 to 1 m (default: from the field of view)
     #[arg(long = "subpixel-m", value_name = "P")]
     subpixel_m: Option<f64>,
     /// Field of view width, m
@@ -77,6 +77,11 @@ pub struct Args {
 /// Most skipped collisions named one by one.
 const MAX_WARNINGS: usize = 20;
 
+/// The subpixel sizes Eq. (8) accepts, m: the pixel range of `track` (a subpixel is a pixel over
+/// the expansion factor). Outside it a subnormal or absurd size gave 0 m subpixels and an
+/// infinite noise in subpixels on stdout (the fuzzer's `--fov-m 5e-324`).
+const SUBPIXEL_M_RANGE: (f64, f64) = restitution::data::frames::job::PIXEL_M_RANGE;
+
 pub fn run(args: Args) -> CliResult {
     let material = args.material.resolve()?;
     for (flag, v) in [
@@ -93,15 +98,32 @@ pub fn run(args: Args) -> CliResult {
     if args.pixels_x == 0 {
         return Err("--pixels-x 0: expected a pixel count > 0".into());
     }
+    let (lo, hi) = SUBPIXEL_M_RANGE;
     let subpixel_m = match args.subpixel_m {
-        Some(p) if p.is_finite() && p > 0.0 => p,
+        Some(p) if (lo..=hi).contains(&p) => p,
         Some(p) => {
             return Err(format!(
-                "--subpixel-m {}: expected a size > 0 (m)",
-                fmt_num(p)
+                "--subpixel-m {}: expected a size in [{}, {}] m",
+                fmt_num(p),
+                fmt_num(lo),
+                fmt_num(hi)
             ));
         }
-        None => args.fov_m / args.pixels_x as f64 / args.subpixel_expansion,
+        None => {
+            let p = args.fov_m / args.pixels_x as f64 / args.subpixel_expansion;
+            if !(lo..=hi).contains(&p) {
+                return Err(format!(
+                    "--fov-m {} / --pixels-x {} / --subpixel-expansion {} = {} m: expected a subpixel size in [{}, {}] m",
+                    fmt_num(args.fov_m),
+                    args.pixels_x,
+                    fmt_num(args.subpixel_expansion),
+                    fmt_num(p),
+                    fmt_num(lo),
+                    fmt_num(hi)
+                ));
+            }
+            p
+        }
     };
     let eq8 = Eq8Inputs {
         s_subpixels: args.s_subpixels,
@@ -239,10 +261,18 @@ pub fn run(args: Args) -> CliResult {
                     r.m.kinematics.time_rule.name()
                 );
             }
+            let sigma_subpixels = sigma / subpixel_m;
+            if !sigma_subpixels.is_finite() {
+                return Err(format!(
+                    "{shown}: the position noise {} m is out of range in subpixels of {} m",
+                    fmt_num(sigma),
+                    fmt_num(subpixel_m)
+                ));
+            }
             s += &format!(
                 "(speeds m/s; e_err from the fits' covariance with the position noise pooled over all collisions: {} m = {:.2} subpixels; e_eq8 from Eq. 8 with s = {} subpixels of {} m; dv: momentum check)\n",
                 fmt_num(sigma),
-                sigma / subpixel_m,
+                sigma_subpixels,
                 fmt_num(args.s_subpixels),
                 fmt_num(subpixel_m)
             );
