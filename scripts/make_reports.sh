@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates every committed data set and report from the committed generators and the tool.
 # Deterministic (all seeded): running it on a clean checkout reproduces the files bit for bit,
-# except timings in reports/bench.
+# except timings in reports/bench and the ms-per-fit lines of reports/walton/coverage.txt.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 cargo build --release --quiet
@@ -59,5 +59,5 @@ $B export --engine lammps --material nylon --d-mm 6.35,25.4 --wall --eta 2000 --
 $B export reports/fit/params.json --engine table --v-range 0.5,40 --walton reports/walton/walton.json \
     --out reports/export/table > reports/export/table/report.txt
 cargo run --release --quiet --example tsuji_accuracy > reports/export/tsuji_accuracy.txt
-# Frames: accuracy of the frame pipeline on rendered frames (10-15 min on 2 cores).
+# Frames: accuracy of the frame pipeline on rendered frames (6.5 min of CPU on 2 cores).
 cargo run --release --quiet --example frames_accuracy > /dev/null

@@ -154,6 +154,7 @@ fn spin_of_a_sphere_at_rest() {
     use common::synth::{Scene, ball};
     use nalgebra::{Rotation3, Vector3};
     use restitution::frames::spin::{MarkerFrame, lift, phase_spin};
+    let mut worst: f64 = 0.0;
     for (w, noise) in [
         (Vector3::new(0.0, 30.0, 0.0), 0.0),
         (Vector3::new(0.0, 30.0, 0.0), 0.01),
@@ -184,9 +185,12 @@ fn spin_of_a_sphere_at_rest() {
                 assert_eq!(pairs, 5);
                 for c in 0..3 {
                     assert!((w_rad_s[c] - w[c]).abs() < 3.0, "{w_rad_s:?} vs {w:?}");
+                    worst = worst.max((w_rad_s[c] - w[c]).abs());
                 }
             }
             other => panic!("{other:?}"),
         }
     }
+    // The README quotes this figure.
+    eprintln!("frames_track: spin_of_a_sphere_at_rest: worst component error {worst:.2} rad/s");
 }

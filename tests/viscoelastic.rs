@@ -346,7 +346,9 @@ fn every_finite_kappa_gives_a_decreasing_number() {
     // From 1e-300 to f64::MAX, both rules, 40 points per decade: e in [0, 1], 1 - e in [0, 1],
     // finite, non-increasing along the grid (the grid step, a factor 1.06, is far above the
     // table seams' ~1e-13 relative jumps), and e = 0 only where the law's value is below half the
-    // smallest subnormal: the overlap rule beyond kappa ~ 3.3e64, the force rule beyond ~6e193.
+    // smallest subnormal, 2^-1075: the overlap rule's A kappa^-5 beyond kappa = 7.3e64, the force
+    // rule's xi_m kappa^(-5/3) beyond 1.72e194 (docs/physics.md §2.7); e > 0 is required up to 7e64
+    // and 1.65e194, grid points a few per cent short of those ends.
     for rule in ContactEnd::ALL {
         let mut last = 1.0f64;
         let mut kappa = 1e-300f64;
@@ -360,8 +362,8 @@ fn every_finite_kappa_gives_a_decreasing_number() {
             );
             assert!(r.e <= last, "{rule} {kappa:e}: {} after {last}", r.e);
             let zero_from = match rule {
-                ContactEnd::Overlap => 3.3e64,
-                ContactEnd::Force => 5e193,
+                ContactEnd::Overlap => 7e64,
+                ContactEnd::Force => 1.65e194,
             };
             if kappa < zero_from {
                 assert!(r.e > 0.0, "{rule} {kappa:e}: e = 0 too early");

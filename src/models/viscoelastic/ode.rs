@@ -10,10 +10,11 @@
 //!
 //! In r the solution is analytic at both ends (p is bounded away from 0 there), so the methods keep
 //! their order and the overlap-rule end is exactly r = 0: no event needs locating. The switches
-//! happen at accepted steps, so they introduce no error. The events that do need locating (the
-//! force-rule end x + kappa p = 0, the turning point p = 0, the force maximum) are found by
-//! safeguarded Newton steps (Illinois regula falsi, Dowell & Jarratt 1971, as the fallback) on
-//! re-integrations from the last accepted step before the event.
+//! happen at accepted steps, so they introduce no error. The events that do need locating are
+//! found on re-integrations from the last accepted step before the event: the force-rule end
+//! x + kappa p = 0 and the turning point p = 0 by safeguarded Newton steps (Illinois regula falsi,
+//! Dowell & Jarratt 1971, as the fallback), the force maximum, whose derivative is not at hand, by
+//! Illinois regula falsi alone (`events::locate`).
 //!
 //! For relative accuracy of 1 - e as kappa -> 0 the dissipated work is integrated as a third
 //! component, J = int x^(1/2) x'^2 dt (dJ/dr = 2 r^2 p), and e comes from the energy balance
