@@ -59,6 +59,7 @@ fn cell_landscape<'a>(obj: &'a Objective<'a>, lo: [f64; 2], hi: [f64; 2]) -> Sep
     let kind = obj.kind;
     let active = [kind != ModelKind::Pm, kind != ModelKind::Vm];
     let mut l = Separable::new(obj, kind == ModelKind::Min, active);
+    l.second_order = true;
     for k in 0..2 {
         l.add_row(k, lo[k]).unwrap();
         l.add_row(k, hi[k]).unwrap();
@@ -175,7 +176,9 @@ fn the_bound_is_second_order_in_the_cell_width() {
                 let l = cell_landscape(&obj, lo, hi);
                 let lowest = sampled_min(&obj, lo, hi, 17);
                 let b = l.bound_with([0, 0], [1, 1], None);
-                let first = l.pass(&l.cell([0, 0], [1, 1]), [0.5, 0.5], true).first;
+                let first = l
+                    .pass(&l.cell([0, 0], [1, 1]), [0.5, 0.5], true, false)
+                    .first;
                 // The first-order bound is not exact here (the data straddle the model).
                 assert!(
                     lowest - first > 1e-4 * lowest,
