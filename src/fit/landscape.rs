@@ -12,6 +12,18 @@
 //! A grid row (e_vm at one eta, or e_pm at one sigma_y, for every point) is tabulated once; a
 //! node costs one min or product per point.
 //!
+//! That first-order bound's gap to chi2 shrinks only like the cell's width h. For large data
+//! ([`super::sums`]) the cells get a second-order bound as well ([`Separable`], derived in
+//! docs/physics.md §7.4): |F_i''| and |G_i''| in the log coordinates are bounded by constants
+//! beside the models (`E_CURVATURE_LN_KAPPA`, `E_CURVATURE_LN_U`), so each factor lies in a
+//! band c + a t (1 - t) around its linear interpolant between the corner rows; the product
+//! (McCormick's envelopes for its cross term) or the min (the smaller factor's band where one is
+//! smaller over the whole cell, else the convex envelope of the lower ends' min) gives each
+//! e_i an interval with convex lower and concave upper end, so
+//! phi = sum_i w_i dist(e_i, interval_i)^2 <= chi2 is convex, and a tangent plane of phi at any
+//! point of the cell, least at a corner, bounds it from below (at the cell's centre and after
+//! projected Newton steps). A cell's bound is the larger of the two.
+//!
 //! **Power law** 1 - e = A (d/d_ref)^(-a) (v/v_ref)^b: for fixed (a, b) it is linear in A, so
 //! chi2 is a convex quadratic in A and its minimum over the box of A is the clamped
 //! least-squares solution: the search runs over (a, b) with A profiled out exactly. With
