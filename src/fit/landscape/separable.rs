@@ -198,6 +198,9 @@ impl<'a> Separable<'a> {
     /// (no bound of phi's minimum can reach it then), or MAX_PASSES (always, without a target).
     fn bound_with(&self, lo: [usize; 2], hi: [usize; 2], target: Option<f64>) -> Bound {
         let cell = self.cell(lo, hi);
+        if !self.second_order && !sums::is_large(self.n) {
+            return self.first_order(&cell);
+        }
         let mut x = [0.5, 0.5];
         // Rounding of a sum of n terms: at most n u of the sum of their magnitudes (any order).
         let margin = 2.0 * (self.n as f64 + 10.0) * f64::EPSILON;
@@ -277,6 +280,35 @@ impl<'a> Separable<'a> {
         Bound {
             lb: first.first.max(second),
             loose: choose(&first, second),
+        }
+    }
+}
+
+impl Separable<'_> {
+    /// The first-order bound and looseness alone, summed over every point as they always were
+    /// (small data: the same cells, hence the same fits, to the last bit).
+    fn first_order(&self, cell: &Cell) -> Bound {
+        let (e, w) = (&self.e[..], &self.w[..]);
+        let min_rule = self.min_rule;
+        let c = |a: f64, b: f64| if min_rule { a.min(b) } else { a * b };
+        let [lb, l0, l1] = sums::sum(self.n, |points| {
+            let (mut lb, mut l0, mut l1) = (0.0, 0.0, 0.0);
+            for i in points {
+                let d = cell.first_order_gap(i, e[i]);
+                lb += w[i] * d * d;
+                let (f0, f1, g0, g1) = (cell.f0[i], cell.f1[i], cell.g0[i], cell.g1[i]);
+                let top = c(f0, g1);
+                let r = (top - e[i]).abs();
+                let d0 = top - c(f1, g1);
+                let d1 = top - c(f0, g0);
+                l0 += w[i] * d0 * (r + d0);
+                l1 += w[i] * d1 * (r + d1);
+            }
+            [lb, l0, l1]
+        });
+        Bound {
+            lb,
+            loose: [l0, l1],
         }
     }
 }
