@@ -12,6 +12,18 @@
 //! A grid row (e_vm at one eta, or e_pm at one sigma_y, for every point) is tabulated once; a
 //! node costs one min or product per point.
 //!
+//! That first-order bound's gap to chi2 shrinks only like the cell's width h. For large data
+//! ([`super::sums`]) the cells get a second-order bound as well ([`Separable`], derived in
+//! docs/physics.md §7.4): |F_i''| and |G_i''| in the log coordinates are bounded by constants
+//! beside the models (`E_CURVATURE_LN_KAPPA`, `E_CURVATURE_LN_U`), so each factor lies in a
+//! band c + a t (1 - t) around its linear interpolant between the corner rows; the product
+//! (McCormick's envelopes for its cross term) or the min (the smaller factor's band where one is
+//! smaller over the whole cell, else the convex envelope of the lower ends' min) gives each
+//! e_i an interval with convex lower and concave upper end, so
+//! phi = sum_i w_i dist(e_i, interval_i)^2 <= chi2 is convex, and a tangent plane of phi at any
+//! point of the cell, least at a corner, bounds it from below (at the cell's centre and after
+//! projected Newton steps). A cell's bound is the larger of the two.
+//!
 //! **Power law** 1 - e = A (d/d_ref)^(-a) (v/v_ref)^b: for fixed (a, b) it is linear in A, so
 //! chi2 is a convex quadratic in A and its minimum over the box of A is the clamped
 //! least-squares solution: the search runs over (a, b) with A profiled out exactly. With
@@ -22,183 +34,20 @@
 //! with f'(A1) <= 0 <= f'(A2) give a valid lower bound of its minimum: the crossing of the
 //! tangents there.
 
-use super::bnb::{Bound, Landscape};
-use super::objective::Objective;
-use super::sums;
-
 mod powerlaw;
+mod separable;
 pub use powerlaw::PowerLaw;
-
-/// For large data (see [`sums`]) the looseness of a cell (which axis to split) is estimated
-/// from every LOOSE_STRIDE-th point: it is half the work of a bound and decides nothing about
-/// the cell (13, prime, so that data repeating a pattern of rows are not sampled in step).
-const LOOSE_STRIDE: usize = 13;
-
-/// The separable models' landscape: rows of e_vm (axis 0) and e_pm (axis 1).
-pub struct Separable<'a> {
-    obj: &'a Objective<'a>,
-    min_rule: bool,
-    active: [bool; 2],
-    n: usize,
-    rows: [Vec<f64>; 2],
-    e: Vec<f64>,
-    w: Vec<f64>,
-    slack: f64,
-}
-
-impl<'a> Separable<'a> {
-    /// `active[k]`: whether axis k (eta, sigma_y) is a parameter; an inactive axis is a row of 1.
-    pub fn new(obj: &'a Objective<'a>, min_rule: bool, active: [bool; 2]) -> Self {
-        let n = obj.ev.len();
-        Separable {
-            obj,
-            min_rule,
-            active,
-            n,
-            rows: [Vec::new(), Vec::new()],
-            e: obj.ev.data.obs.iter().map(|o| o.e).collect(),
-            w: obj.inv_sigma.iter().map(|s| s * s).collect(),
-            slack: 2.0 * obj.e_accuracy,
-        }
-    }
-
-    fn row(&self, k: usize, r: usize) -> &[f64] {
-        &self.rows[k][r * self.n..(r + 1) * self.n]
-    }
-
-    fn bound_with(
-        &self,
-        c: impl Fn(f64, f64) -> f64 + Sync,
-        lo: [usize; 2],
-        hi: [usize; 2],
-    ) -> Bound {
-        let (f0, f1) = (self.row(0, lo[0]), self.row(0, hi[0]));
-        let (g0, g1) = (self.row(1, lo[1]), self.row(1, hi[1]));
-        let (e, w, slack) = (&self.e[..], &self.w[..], self.slack);
-        // F falls along axis 0, G rises along axis 1: the extremes are opposite corners. Point
-        // i's top of the cell, and its distance outside [bottom, top] widened by the slack.
-        let gap = |i: usize| {
-            let top = c(f0[i], g1[i]);
-            let bottom = c(f1[i], g0[i]) - slack;
-            let ei = e[i];
-            let d = if ei < bottom {
-                bottom - ei
-            } else if ei > top + slack {
-                ei - top - slack
-            } else {
-                0.0
-            };
-            (top, d)
-        };
-        // Point i's looseness along each axis (chooses the axis to split, never decides a cell).
-        let loose = |i: usize, top: f64| {
-            let r = (top - e[i]).abs();
-            let d0 = top - c(f1[i], g1[i]);
-            let d1 = top - c(f0[i], g0[i]);
-            (w[i] * d0 * (r + d0), w[i] * d1 * (r + d1))
-        };
-        let large = sums::is_large(self.n);
-        let [lb, l0, l1] = sums::sum(self.n, |points| {
-            let (mut lb, mut l0, mut l1) = (0.0, 0.0, 0.0);
-            if large {
-                // The bound over every point; the looseness from every LOOSE_STRIDE-th.
-                for i in points.clone() {
-                    let (_, d) = gap(i);
-                    lb += w[i] * d * d;
-                }
-                for i in points.step_by(LOOSE_STRIDE) {
-                    let (a0, a1) = loose(i, gap(i).0);
-                    l0 += a0;
-                    l1 += a1;
-                }
-                return [lb, l0, l1];
-            }
-            for i in points {
-                let (top, d) = gap(i);
-                lb += w[i] * d * d;
-                let (a0, a1) = loose(i, top);
-                l0 += a0;
-                l1 += a1;
-            }
-            [lb, l0, l1]
-        });
-        Bound {
-            lb,
-            loose: [l0, l1],
-        }
-    }
-}
-
-impl Landscape for Separable<'_> {
-    fn add_row(&mut self, axis: usize, t: f64) -> Result<(), String> {
-        let (n, ev) = (self.n, self.obj.ev);
-        let start = self.rows[axis].len();
-        self.rows[axis].resize(start + n, 1.0);
-        if !self.active[axis] {
-            return Ok(());
-        }
-        self.obj.evals.set(self.obj.evals.get() + 1);
-        let x = t.exp();
-        let row = &mut self.rows[axis][start..start + n];
-        if axis == 1 {
-            ev.e_pm_row(x, row);
-        } else {
-            sums::fill(row, |i| ev.e_vm(i, x).unwrap_or(f64::NAN));
-        }
-        // The first point that failed names the failure (the evaluation's error if it gave
-        // one, else the NaN).
-        let Some(i) = row.iter().position(|v| v.is_nan()) else {
-            return Ok(());
-        };
-        let error = if axis == 0 { ev.e_vm(i, x).err() } else { None };
-        Err(match error {
-            Some(e) => format!("e_vm at eta = {x}: {e}"),
-            None => format!(
-                "the model is NaN at {} = {x} for {}",
-                if axis == 0 { "eta" } else { "sigma_y" },
-                self.obj.describe_point(i)
-            ),
-        })
-    }
-
-    fn node(&self, r: [usize; 2]) -> f64 {
-        let (f, g) = (self.row(0, r[0]), self.row(1, r[1]));
-        let (e, w) = (&self.e[..], &self.w[..]);
-        let min_rule = self.min_rule;
-        let [s] = sums::sum(self.n, |points| {
-            let mut s = 0.0;
-            if min_rule {
-                for i in points {
-                    let d = f[i].min(g[i]) - e[i];
-                    s += w[i] * d * d;
-                }
-            } else {
-                for i in points {
-                    let d = f[i] * g[i] - e[i];
-                    s += w[i] * d * d;
-                }
-            }
-            [s]
-        });
-        s
-    }
-
-    fn bound(&self, lo: [usize; 2], hi: [usize; 2], _target: f64) -> Bound {
-        if self.min_rule {
-            self.bound_with(f64::min, lo, hi)
-        } else {
-            self.bound_with(|a, b| a * b, lo, hi)
-        }
-    }
-}
+pub use separable::Separable;
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::contact::Material;
+    use crate::fit::bnb::Landscape;
     use crate::fit::dataset::{FitData, Observation};
     use crate::fit::lsq;
     use crate::fit::models::{Evaluator, ModelKind};
+    use crate::fit::objective::Objective;
     use crate::models::viscoelastic::{ContactEnd, VmMethod, master::KAPPA_MAX, restitution};
 
     /// Noisy-looking data (a fixed pattern, no model behind it) on three sizes and a wall.

@@ -302,14 +302,16 @@ impl<'a> Evaluator<'a> {
     }
 
     /// Model e at every point for physical parameters `p` (order of [`ModelKind::params`]).
+    /// Large data are evaluated in chunks on all cores ([`super::sums`]); each value is computed
+    /// alone, and an error is the first failing point's, as in point order.
     pub fn predict(&self, kind: ModelKind, p: &[f64], out: &mut [f64]) -> Result<()> {
         let s25 = match kind {
             ModelKind::Pm => p[0].powf(2.5),
             ModelKind::Min | ModelKind::Product => p[1].powf(2.5),
             _ => f64::NAN,
         };
-        for (i, slot) in out.iter_mut().enumerate().take(self.len()) {
-            *slot = match kind {
+        let one = |i: usize| -> Result<f64> {
+            Ok(match kind {
                 ModelKind::Vm => self.e_vm(i, p[0])?,
                 ModelKind::Pm => self.e_pm_s25(i, s25),
                 ModelKind::Min => self.e_vm(i, p[0])?.min(self.e_pm_s25(i, s25)),
@@ -318,9 +320,26 @@ impl<'a> Evaluator<'a> {
                     1.0 - (p[0].ln() - p[1] * self.powerlaw_ln_d[i] + p[2] * self.powerlaw_ln_v[i])
                         .exp()
                 }
-            };
+            })
+        };
+        let n = self.len().min(out.len());
+        let chunk = |start: usize, slots: &mut [f64]| -> Result<()> {
+            for (j, slot) in slots.iter_mut().enumerate() {
+                *slot = one(start + j)?;
+            }
+            Ok(())
+        };
+        if !super::sums::is_large(n) {
+            return chunk(0, &mut out[..n]);
         }
-        Ok(())
+        use rayon::prelude::*;
+        let size = super::sums::CHUNK;
+        let results: Vec<Result<()>> = out[..n]
+            .par_chunks_mut(size)
+            .enumerate()
+            .map(|(c, slots)| chunk(c * size, slots))
+            .collect();
+        results.into_iter().collect()
     }
 }
 

@@ -36,6 +36,14 @@ use crate::error::{Error, Num, Result, in_range, positive};
 /// From this u on, [`rebound_u`] uses the four-term large-u form (module docs).
 pub const U_ASYMPTOTE: f64 = 1e6;
 
+/// A bound on |d^2 e / d(ln u)^2| over every u > 0, taken piecewise: e is C^1 at yield (u = 1,
+/// where 1 - e ~ (6/25)(u - 1)^2, docs/physics.md §3.5) but not C^2, its second derivative
+/// jumping from 0 to -12/25 there, and smooth on either side; a bound on each side is what the
+/// error of linear interpolation needs (e' is then Lipschitz). The measured maximum is that 0.48
+/// at u -> 1+ (the test below samples second differences from u = 1e-3 to 1e12), taken with a
+/// margin of 1.5. The global search's cell bounds rest on it (docs/physics.md §7.4).
+pub const E_CURVATURE_LN_U: f64 = 0.72;
+
 /// The large-u asymptote e ~ C u^(-1/4): C = (sqrt 30 / 5)(2 sqrt 30 / 15)^(-1/4) = 1.18499...
 /// (the paper's 1.18, Eq. 18).
 pub fn asymptote_c() -> f64 {
@@ -226,6 +234,32 @@ impl Plastic {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn curvature_in_ln_u_stays_below_its_bound_with_its_margin() {
+        // Second differences in t = ln u, h = 1e-4, on a grid of step 1e-4 over u in
+        // [1e-3, 1e12] (the closed form's 1.2 ulp moves them by at most 1e-7; each is the second
+        // derivative at a point within h of t, and those straddling yield average its jump).
+        // The maximum must stay below the bound over its margin 1.5 and be the 12/25 the doc
+        // derives (to 2e-3: the grid's nearest second difference to u = 1+).
+        let h = 1e-4;
+        let (t0, t1) = (1e-3f64.ln(), 1e12f64.ln());
+        let steps = ((t1 - t0) / h) as usize;
+        let e = |t: f64| rebound_u(t.exp()).e;
+        let mut worst: f64 = 0.0;
+        for k in 1..steps {
+            let t = t0 + k as f64 * h;
+            let d2 = (e(t + h) - 2.0 * e(t) + e(t - h)) / (h * h);
+            assert!(d2.is_finite(), "u {}", t.exp());
+            worst = worst.max(d2.abs());
+        }
+        eprintln!("max |d2 e_pm / d(ln u)^2| = {worst}");
+        assert!(
+            worst <= E_CURVATURE_LN_U / 1.5,
+            "max |e''| = {worst} above {E_CURVATURE_LN_U} / 1.5"
+        );
+        assert!((worst - 0.48).abs() < 2e-3, "max |e''| = {worst}");
+    }
 
     #[test]
     fn asymptote_constant() {

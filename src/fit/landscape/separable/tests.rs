@@ -1,0 +1,214 @@
+use super::*;
+use crate::contact::Material;
+use crate::fit::dataset::{FitData, Observation};
+use crate::fit::lsq;
+use crate::fit::models::{Evaluator, ModelKind};
+use crate::models::viscoelastic::{ContactEnd, VmMethod};
+
+const KINDS: [ModelKind; 4] = [
+    ModelKind::Vm,
+    ModelKind::Pm,
+    ModelKind::Min,
+    ModelKind::Product,
+];
+
+/// Points on three sizes and a wall over speeds 0.4 to 0.4 x 1.12^(n-1) m/s, every speed moved
+/// a little (distinct points). `model`: e from `min` at eta = 190, sigma_y = 4e7 plus a fixed
+/// scatter of 0.01 (a landscape with a minimum); else a fixed pattern with no model behind it.
+fn data(n: usize, model: bool) -> FitData {
+    let m = Material::preset("nylon").unwrap();
+    let mut obs: Vec<Observation> = (0..n)
+        .map(|k| Observation {
+            d_mm: [6.35, 12.7, 25.4, 12.7][k % 4],
+            d2_mm: if k % 4 == 3 {
+                Some(f64::INFINITY)
+            } else {
+                None
+            },
+            v_n_m_s: 0.4
+                * 1.12f64.powi((k % 40) as i32)
+                * (1.0 + 1e-3 * ((k * 7919 % 2001) as f64 / 1000.0 - 1.0)),
+            e: 0.97 - 0.006 * (k % 40) as f64 + 0.02 * ((k * 7 % 5) as f64 - 2.0) / 2.0,
+            e_err: Some(0.01 + 0.001 * (k % 3) as f64),
+        })
+        .collect();
+    if model {
+        let d = FitData::new(m, obs.clone()).unwrap();
+        let ev = Evaluator::new(&d, ContactEnd::Overlap, VmMethod::Master);
+        let mut e = vec![0.0; n];
+        ev.predict(ModelKind::Min, &[190.0, 4e7], &mut e).unwrap();
+        for (k, o) in obs.iter_mut().enumerate() {
+            o.e = e[k] + 0.01 * ((k * 7 % 5) as f64 - 2.0) / 2.0;
+        }
+    }
+    FitData::new(m, obs).unwrap()
+}
+
+/// chi2 at internal coordinates t (log eta, log sigma_y), straight from the model.
+fn direct(obj: &Objective, t: [f64; 2]) -> f64 {
+    let theta = match obj.kind {
+        ModelKind::Vm => vec![t[0]],
+        ModelKind::Pm => vec![t[1]],
+        _ => vec![t[0], t[1]],
+    };
+    lsq::chi2(obj, &theta).unwrap()
+}
+
+/// The landscape of `kind` with the two rows of each axis of one cell.
+fn cell_landscape<'a>(obj: &'a Objective<'a>, lo: [f64; 2], hi: [f64; 2]) -> Separable<'a> {
+    let kind = obj.kind;
+    let active = [kind != ModelKind::Pm, kind != ModelKind::Vm];
+    let mut l = Separable::new(obj, kind == ModelKind::Min, active);
+    l.second_order = true;
+    for k in 0..2 {
+        l.add_row(k, lo[k]).unwrap();
+        l.add_row(k, hi[k]).unwrap();
+    }
+    l
+}
+
+/// The least chi2 on an m x m grid of the cell (corners included).
+fn sampled_min(obj: &Objective, lo: [f64; 2], hi: [f64; 2], m: usize) -> f64 {
+    let mut lowest = f64::INFINITY;
+    for i in 0..m {
+        for j in 0..m {
+            let f = |k: usize, a: usize| lo[k] + (hi[k] - lo[k]) * a as f64 / (m - 1) as f64;
+            lowest = lowest.min(direct(obj, [f(0, i), f(1, j)]));
+        }
+    }
+    lowest
+}
+
+/// Every bound, whatever the target it is asked for (or none: every pass), lies below chi2 sampled densely in its
+/// cell (an m x m grid; chi2 computed from the model, not from the rows), and is finite and
+/// non-negative. Rounding allowed: 1e-12 relative (the two sides sum the same squares in
+/// different forms).
+fn check(d: &FitData, rule: ContactEnd, cells: &[([f64; 2], [f64; 2])], m: usize) {
+    let ev = Evaluator::new(d, rule, VmMethod::Master);
+    for kind in KINDS {
+        let obj = Objective::new(&ev, kind).unwrap();
+        for &(lo, hi) in cells {
+            let l = cell_landscape(&obj, lo, hi);
+            let lowest = sampled_min(&obj, lo, hi, m);
+            let targets = [f64::NEG_INFINITY, 0.5 * lowest, lowest, f64::INFINITY];
+            let full = l.bound_with([0, 0], [1, 1], None).lb;
+            for b in targets
+                .map(|t| l.bound([0, 0], [1, 1], t).lb)
+                .into_iter()
+                .chain([full])
+            {
+                assert!(
+                    b <= lowest * (1.0 + 1e-12),
+                    "{kind} {rule:?} {lo:?} {hi:?}: {b} > {lowest}"
+                );
+                assert!(b >= 0.0 && b.is_finite(), "{kind} {lo:?} {hi:?}: {b}");
+            }
+        }
+    }
+}
+
+/// Cells of widths 1e-4 to 3 in each log parameter around the minimum of the model data, away
+/// from it, across the yield edge (sigma_y where the points start to yield) and on the plateau
+/// where none yields.
+fn cells() -> Vec<([f64; 2], [f64; 2])> {
+    let (e, s) = (190f64.ln(), 4e7f64.ln());
+    let mut out = Vec::new();
+    for (ce, cs) in [
+        (e, s),
+        (e + 0.02, s - 0.01),
+        (e + 1.5, s - 1.0),
+        (e - 2.0, s + 0.5),
+        (e, s + 1.5),
+        (e + 0.3, s + 4.0),
+    ] {
+        for (w0, w1) in [
+            (1e-4, 1e-4),
+            (1e-2, 3e-3),
+            (0.1, 0.3),
+            (1.0, 0.05),
+            (3.0, 2.0),
+        ] {
+            out.push((
+                [ce - 0.4 * w0, cs - 0.6 * w1],
+                [ce + 0.6 * w0, cs + 0.4 * w1],
+            ));
+        }
+    }
+    out
+}
+
+#[test]
+fn bounds_are_below_chi2_everywhere_in_their_cells_of_every_size() {
+    for model in [true, false] {
+        check(&data(40, model), ContactEnd::Overlap, &cells(), 17);
+    }
+    check(&data(40, true), ContactEnd::Force, &cells(), 9);
+}
+
+#[test]
+fn large_data_bounds_are_below_chi2_everywhere_in_their_cells() {
+    // Above the parallel threshold the sums are chunked and the looseness sampled: a few cells
+    // of each size class on distinct points.
+    let d = data(sums::PARALLEL_MIN_POINTS + 1000, true);
+    assert!(sums::is_large(d.len()));
+    let cells: Vec<_> = cells().into_iter().step_by(4).collect();
+    check(&d, ContactEnd::Overlap, &cells, 7);
+}
+
+#[test]
+fn the_bound_is_second_order_in_the_cell_width() {
+    // Near the minimum of the model data (where the search spends its cells) the first-order
+    // bound's gap to chi2 falls like the width h and the second-order one's like h^2 (or
+    // vanishes, when chi2 is least at a corner: the bands are zero there). A quarter of the
+    // width must cut the second-order gap by more than 8 (16 in the limit; a first-order bound
+    // gives 4), unless it is already below 1e-6 of chi2, and at h = 0.005 it must be under a
+    // tenth of the first-order gap.
+    let d = data(40, true);
+    let ev = Evaluator::new(&d, ContactEnd::Overlap, VmMethod::Master);
+    for kind in KINDS {
+        let obj = Objective::new(&ev, kind).unwrap();
+        for (ce, cs) in [
+            (190f64.ln(), 4e7f64.ln()),
+            (190f64.ln() + 0.1, 4e7f64.ln() - 0.05),
+        ] {
+            let gaps = |h: f64| {
+                let (lo, hi) = ([ce - 0.5 * h, cs - 0.5 * h], [ce + 0.5 * h, cs + 0.5 * h]);
+                let l = cell_landscape(&obj, lo, hi);
+                let lowest = sampled_min(&obj, lo, hi, 17);
+                let b = l.bound_with([0, 0], [1, 1], None);
+                let first = l
+                    .pass(&l.cell([0, 0], [1, 1]), [0.5, 0.5], true, false)
+                    .first;
+                // The first-order bound is not exact here (the data straddle the model).
+                assert!(
+                    lowest - first > 1e-4 * lowest,
+                    "{kind}: {first} vs {lowest}"
+                );
+                (lowest - b.lb, lowest - first, lowest)
+            };
+            let (g2, _, _) = gaps(0.02);
+            let (h2, h1, lowest) = gaps(0.005);
+            eprintln!("{kind} {ce} {cs}: second {g2:e} -> {h2:e}, first {h1:e}");
+            assert!(g2 >= 0.0 && h2 >= 0.0, "{kind}: {g2} {h2}");
+            assert!(h2 < 0.1 * h1, "{kind}: {h2} vs first order {h1}");
+            assert!(h2 < g2 / 8.0 || h2 < 1e-6 * lowest, "{kind}: {g2} -> {h2}");
+        }
+    }
+}
+
+#[test]
+fn newton_steps_stay_in_the_cell_and_stop_without_curvature() {
+    // A quadratic with its minimum at (0.8, 0.3) is reached in one step; one outside the cell
+    // (at (1.5, 0.3), no correlation) is clipped to s = 1 with u re-minimised to 0.3; a model
+    // with no curvature has no step.
+    let h = [2.0, 0.0, 4.0];
+    let g_at = |x: [f64; 2], m: [f64; 2]| [2.0 * (x[0] - m[0]), 4.0 * (x[1] - m[1])];
+    let y = newton_step([0.5, 0.5], g_at([0.5, 0.5], [0.8, 0.3]), h).unwrap();
+    assert!(
+        (y[0] - 0.8).abs() < 1e-9 && (y[1] - 0.3).abs() < 1e-9,
+        "{y:?}"
+    );
+    let y = newton_step([0.5, 0.5], g_at([0.5, 0.5], [1.5, 0.3]), h).unwrap();
+    assert!(y[0] == 1.0 && (y[1] - 0.3).abs() < 1e-9, "{y:?}");
+    assert!(newton_step([0.5, 0.5], [1.0, 1.0], [0.0; 3]).is_none());
+}
