@@ -5,13 +5,21 @@ use super::super::bnb::{Bound, Landscape};
 use super::super::models::{POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S, powerlaw_d_mm};
 use super::super::objective::Objective;
 use super::super::sums;
+use rayon::prelude::*;
 use std::cell::RefCell;
+use std::collections::HashMap;
+
+mod linearized;
 
 /// Relative widening of the z ranges of the power law: a few rounding errors of exp and a
 /// product (1e-12 is 4500 ulp).
 const Z_SLACK: f64 = 1e-12;
 /// Newton or bisection steps per cell bound of the power law (each one pass over the points).
 const POWERLAW_BOUND_ITERS: usize = 30;
+/// The linearised bound is tried first on cells where every point's exponent varies by at most
+/// this much (max_i M_i, see [`linearized`]); wider cells use the first-order bound alone (its
+/// remainder exp(M) - 1 - M is then as wide as the first-order range).
+const LINEARISED_MAX_M: f64 = 1.0;
 
 /// The power law's landscape over (a, b), A profiled out.
 pub struct PowerLaw {
@@ -33,9 +41,17 @@ pub struct PowerLaw {
     sens: [f64; 2],
     /// How close to its minimum a cell bound is computed (efficiency only: any stop is valid).
     pub bound_tol: f64,
-    /// The z ranges of the last cell bound, kept so that each bound does not allocate (and, for
-    /// large data, fault in) two fresh arrays of the points.
-    scratch: RefCell<(Vec<f64>, Vec<f64>)>,
+    /// max_i |c1_i| and max_i |c2_i|.
+    c_max: [f64; 2],
+    /// The z ranges (zlo, zhi), centre values zc and remainders zc R of the last cell bound
+    /// (see [`linearized`]), kept so that each bound does not allocate (and, for large data,
+    /// fault in) fresh arrays of the points.
+    scratch: RefCell<[Vec<f64>; 4]>,
+    /// The centred amplitude minimising chi2 at each node evaluated (a start for the cells'
+    /// bounds).
+    amplitudes: RefCell<HashMap<[usize; 2], f64>>,
+    /// sum_i w_i y_i^2.
+    wy2: f64,
 }
 
 impl PowerLaw {
@@ -55,6 +71,7 @@ impl PowerLaw {
         let m1 = x1.iter().sum::<f64>() / n as f64;
         let m2 = x2.iter().sum::<f64>() / n as f64;
         let w: Vec<f64> = obj.inv_sigma.iter().map(|s| s * s).collect();
+        let wy2 = (0..n).map(|i| w[i] * (1.0 - data.obs[i].e).powi(2)).sum();
         let wmax = w.iter().cloned().fold(0.0, f64::max);
         PowerLaw {
             n,
@@ -71,6 +88,10 @@ impl PowerLaw {
                     .sqrt(),
             ],
             w,
+            c_max: [
+                x1.iter().map(|x| (x - m1).abs()).fold(0.0, f64::max),
+                x2.iter().map(|x| (x - m2).abs()).fold(0.0, f64::max),
+            ],
             c1: x1.iter().map(|x| x - m1).collect(),
             c2: x2.iter().map(|x| x - m2).collect(),
             m1,
@@ -79,7 +100,9 @@ impl PowerLaw {
             rows: [Vec::new(), Vec::new()],
             t: [Vec::new(), Vec::new()],
             bound_tol: 0.0,
-            scratch: RefCell::new((vec![0.0; n], vec![0.0; n])),
+            scratch: RefCell::new([vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]]),
+            amplitudes: RefCell::new(HashMap::new()),
+            wy2,
         }
     }
 
@@ -253,23 +276,27 @@ impl Landscape for PowerLaw {
     }
 
     fn node(&self, r: [usize; 2]) -> f64 {
-        self.profile(r).1
+        let (ln_a, chi2) = self.profile(r);
+        let (a, b) = (self.t[0][r[0]], self.t[1][r[1]]);
+        self.amplitudes
+            .borrow_mut()
+            .insert(r, (ln_a + self.shift(a, b)).exp());
+        chi2
     }
 
     fn bound(&self, lo: [usize; 2], hi: [usize; 2], target: f64) -> Bound {
-        let (za0, za1) = (self.row(0, lo[0]), self.row(0, hi[0]));
-        let (zb0, zb1) = (self.row(1, lo[1]), self.row(1, hi[1]));
-        let mut scratch = self.scratch.borrow_mut();
-        let (zlo, zhi) = &mut *scratch;
-        sums::fill(zlo, |i| {
-            za0[i].min(za1[i]) * zb0[i].min(zb1[i]) * (1.0 - Z_SLACK)
-        });
-        sums::fill(zhi, |i| {
-            za0[i].max(za1[i]) * zb0[i].max(zb1[i]) * (1.0 + Z_SLACK)
-        });
-        // The box of the centred amplitude over the cell: the shift is linear in a and b.
         let (a0, a1) = (self.t[0][lo[0]], self.t[0][hi[0]]);
         let (b0, b1) = (self.t[1][lo[1]], self.t[1][hi[1]]);
+        // Half-widths rounded up (a difference and a halving, each within an ulp).
+        let h = [
+            0.5 * (a1 - a0) * (1.0 + 1e-15),
+            0.5 * (b1 - b0) * (1.0 + 1e-15),
+        ];
+        let linearise = self.c_max[0] * h[0] + self.c_max[1] * h[1] <= LINEARISED_MAX_M;
+        let mut scratch = self.scratch.borrow_mut();
+        let [zlo, zhi, zc, rz] = &mut *scratch;
+        let mags = self.fill_cell(lo, hi, linearise.then_some(h), [zlo, zhi, zc, rz]);
+        // The box of the centred amplitude over the cell: the shift is linear in a and b.
         let shifts = [
             self.shift(a0, b0),
             self.shift(a1, b0),
@@ -278,32 +305,153 @@ impl Landscape for PowerLaw {
         ];
         let smin = shifts.iter().cloned().fold(f64::INFINITY, f64::min);
         let smax = shifts.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-        let (mut x1, mut x2) = (self.a_range.0 * smin.exp(), self.a_range.1 * smax.exp());
+        let ends = (self.a_range.0 * smin.exp(), self.a_range.1 * smax.exp());
         // How much each axis loosens the bound: its width times the model's sensitivity to it.
         let wa = (a1 - a0) * self.sens[0];
         let wb = (b1 - b0) * self.sens[1];
-        let loose = |_: f64| [wa * wa, wb * wb];
-        if sums::is_large(self.n) {
-            let lb = self.bound_from_inside(zlo, zhi, (x1, x2), target);
-            // chi2 >= 0 always; a NaN bound (overflow) is passed on for the search to report.
-            return Bound {
-                lb: if lb < 0.0 { 0.0 } else { lb },
-                loose: loose(0.0),
+        let loose = [wa * wa, wb * wb];
+        let mut lb = f64::NEG_INFINITY;
+        if linearise {
+            let cell = linearized::Cell {
+                y: &self.y,
+                w: &self.w,
+                c1: &self.c1,
+                c2: &self.c2,
+                zlo,
+                zhi,
+                zc,
+                rz,
+                h,
+                ends,
+                start: self.start_amplitude(lo, hi),
+                wy2: self.wy2,
+                mags,
             };
+            // A NaN (sums that overflowed) gives no bound: the first-order one reports it.
+            let l = linearized::bound(&cell, target, self.bound_tol);
+            if l > lb {
+                lb = l;
+            }
         }
+        if !(lb >= target) {
+            let first = if sums::is_large(self.n) {
+                self.bound_from_inside(zlo, zhi, ends, target)
+            } else {
+                self.first_order(zlo, zhi, ends, target)
+            };
+            // A NaN bound (overflow) is passed on for the search to report.
+            lb = if first.is_nan() { first } else { lb.max(first) };
+        }
+        // chi2 >= 0 always.
+        Bound {
+            lb: if lb < 0.0 { 0.0 } else { lb },
+            loose,
+        }
+    }
+}
+
+impl PowerLaw {
+    /// The geometric mean of the amplitudes at the cell's corners (0 when none is known).
+    fn start_amplitude(&self, lo: [usize; 2], hi: [usize; 2]) -> f64 {
+        let amps = self.amplitudes.borrow();
+        let corners = [lo, [hi[0], lo[1]], [lo[0], hi[1]], hi];
+        let logs: Vec<f64> = corners
+            .iter()
+            .filter_map(|r| amps.get(r))
+            .filter(|a| a.is_finite() && **a > 0.0)
+            .map(|a| a.ln())
+            .collect();
+        if logs.is_empty() {
+            return 0.0;
+        }
+        (logs.iter().sum::<f64>() / logs.len() as f64).exp()
+    }
+
+    /// The scratch arrays of the cell between rows `lo` and `hi`: zlo and zhi (widened by
+    /// Z_SLACK), and with the half-widths `h` the centre's zc and the remainder zc R(M) of
+    /// [`linearized`] (exp(M) from the rows' ratios, no exp per point); returns the sums of
+    /// [`linearized::magnitudes`] (zero without `h`).
+    fn fill_cell(
+        &self,
+        lo: [usize; 2],
+        hi: [usize; 2],
+        h: Option<[f64; 2]>,
+        out: [&mut Vec<f64>; 4],
+    ) -> [f64; 4] {
+        let (za0, za1) = (self.row(0, lo[0]), self.row(0, hi[0]));
+        let (zb0, zb1) = (self.row(1, lo[1]), self.row(1, hi[1]));
+        let (c1, c2, w) = (&self.c1[..], &self.c2[..], &self.w[..]);
+        let point = |i: usize, o: [&mut f64; 4], m: &mut [f64; 4]| {
+            let (amin, amax) = (za0[i].min(za1[i]), za0[i].max(za1[i]));
+            let (bmin, bmax) = (zb0[i].min(zb1[i]), zb0[i].max(zb1[i]));
+            let zhi = amax * bmax * (1.0 + Z_SLACK);
+            *o[0] = amin * bmin * (1.0 - Z_SLACK);
+            *o[1] = zhi;
+            let Some([ha, hb]) = h else {
+                return;
+            };
+            // exp(-a_c c1) = sqrt(exp(-a0 c1) exp(-a1 c1)); the product of two rows can
+            // overflow where the rows do not: then a square root each.
+            let mut zc = (za0[i] * za1[i]).sqrt() * (zb0[i] * zb1[i]).sqrt();
+            if !(zc.is_finite() && zc > 0.0) {
+                zc = (amin.sqrt() * amax.sqrt()) * (bmin.sqrt() * bmax.sqrt());
+            }
+            let e_m = (amax / amin).sqrt() * (bmax / bmin).sqrt();
+            let rz = zc * linearized::remainder_bound(c1[i].abs() * ha + c2[i].abs() * hb, e_m);
+            *o[2] = zc;
+            *o[3] = rz;
+            let t = linearized::magnitudes(w[i], zhi, zc, rz, c1[i], c2[i]);
+            for k in 0..4 {
+                m[k] += t[k];
+            }
+        };
+        let [o0, o1, o2, o3] = out;
+        let mut mags = [0.0; 4];
+        if !sums::is_large(self.n) {
+            for i in 0..self.n {
+                point(
+                    i,
+                    [&mut o0[i], &mut o1[i], &mut o2[i], &mut o3[i]],
+                    &mut mags,
+                );
+            }
+            return mags;
+        }
+        // Chunks in parallel, their sums added in chunk order (as in [`sums::sum`]).
+        let parts: Vec<[f64; 4]> = o0
+            .par_chunks_mut(sums::CHUNK)
+            .zip(o1.par_chunks_mut(sums::CHUNK))
+            .zip(o2.par_chunks_mut(sums::CHUNK))
+            .zip(o3.par_chunks_mut(sums::CHUNK))
+            .enumerate()
+            .map(|(c, (((p0, p1), p2), p3))| {
+                let mut m = [0.0; 4];
+                for j in 0..p0.len() {
+                    let o = [&mut p0[j], &mut p1[j], &mut p2[j], &mut p3[j]];
+                    point(c * sums::CHUNK + j, o, &mut m);
+                }
+                m
+            })
+            .collect();
+        for p in parts {
+            for k in 0..4 {
+                mags[k] += p[k];
+            }
+        }
+        mags
+    }
+
+    /// The first-order bound for small data (module doc of the parent): the tangents' crossing
+    /// from the box's ends inwards; negative or NaN passed on.
+    fn first_order(&self, zlo: &[f64], zhi: &[f64], ends: (f64, f64), target: f64) -> f64 {
+        let (mut x1, mut x2) = ends;
         let (mut f1, mut d1, _) = self.f_slope_curv(zlo, zhi, x1);
         if d1 >= 0.0 {
-            return Bound {
-                lb: f1,
-                loose: loose(x1),
-            };
+            return f1;
         }
         let (mut f2, mut d2, _) = self.f_slope_curv(zlo, zhi, x2);
         if d2 <= 0.0 {
-            return Bound {
-                lb: f2,
-                loose: loose(x2),
-            };
+            return f2;
         }
         // f'(x1) < 0 < f'(x2): the tangents' crossing is a lower bound. Newton steps on the
         // piecewise linear f' (exact on each piece) move the bracket in; bisection (geometric, A
@@ -337,10 +485,6 @@ impl Landscape for PowerLaw {
             }
             x -= d / h;
         }
-        // chi2 >= 0 always; a NaN bound (overflow) is passed on for the search to report.
-        Bound {
-            lb: if lb < 0.0 { 0.0 } else { lb },
-            loose: loose(0.5 * (x1 + x2)),
-        }
+        lb
     }
 }
