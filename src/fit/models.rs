@@ -301,8 +301,20 @@ impl<'a> Evaluator<'a> {
         super::sums::fill(&mut out[..n], |i| self.e_pm_s25(i, s25));
     }
 
+    /// The power law's e at point `i` for ln A and exponents a, b.
+    fn e_powerlaw(&self, i: usize, ln_a: f64, a: f64, b: f64) -> f64 {
+        1.0 - (ln_a - a * self.powerlaw_ln_d[i] + b * self.powerlaw_ln_v[i]).exp()
+    }
+
     /// Model e at every point for physical parameters `p` (order of [`ModelKind::params`]).
     pub fn predict(&self, kind: ModelKind, p: &[f64], out: &mut [f64]) -> Result<()> {
+        let n = self.len().min(out.len());
+        if kind == ModelKind::PowerLaw && super::sums::is_large(n) {
+            // In parallel (each value computed alone: the same on any thread).
+            let ln_a = p[0].ln();
+            super::sums::fill(&mut out[..n], |i| self.e_powerlaw(i, ln_a, p[1], p[2]));
+            return Ok(());
+        }
         let s25 = match kind {
             ModelKind::Pm => p[0].powf(2.5),
             ModelKind::Min | ModelKind::Product => p[1].powf(2.5),
@@ -314,10 +326,7 @@ impl<'a> Evaluator<'a> {
                 ModelKind::Pm => self.e_pm_s25(i, s25),
                 ModelKind::Min => self.e_vm(i, p[0])?.min(self.e_pm_s25(i, s25)),
                 ModelKind::Product => self.e_vm(i, p[0])? * self.e_pm_s25(i, s25),
-                ModelKind::PowerLaw => {
-                    1.0 - (p[0].ln() - p[1] * self.powerlaw_ln_d[i] + p[2] * self.powerlaw_ln_v[i])
-                        .exp()
-                }
+                ModelKind::PowerLaw => self.e_powerlaw(i, p[0].ln(), p[1], p[2]),
             };
         }
         Ok(())

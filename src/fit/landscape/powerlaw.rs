@@ -16,10 +16,11 @@ mod linearized;
 const Z_SLACK: f64 = 1e-12;
 /// Newton or bisection steps per cell bound of the power law (each one pass over the points).
 const POWERLAW_BOUND_ITERS: usize = 30;
-/// The linearised bound is tried first on cells where every point's exponent varies by at most
-/// this much (max_i M_i, see [`linearized`]); wider cells use the first-order bound alone (its
-/// remainder exp(M) - 1 - M is then as wide as the first-order range).
-const LINEARISED_MAX_M: f64 = 1.0;
+/// On cells where every point's exponent varies by at most NARROW_M (max_i M_i, see
+/// [`linearized`]) the linearised bound is used alone; on cells up to WIDE_M after the
+/// first-order one when that did not decide; wider cells use the first-order bound alone.
+const NARROW_M: f64 = 1.0;
+const WIDE_M: f64 = 4.0;
 
 /// The power law's landscape over (a, b), A profiled out.
 pub struct PowerLaw {
@@ -292,10 +293,11 @@ impl Landscape for PowerLaw {
             0.5 * (a1 - a0) * (1.0 + 1e-15),
             0.5 * (b1 - b0) * (1.0 + 1e-15),
         ];
-        let linearise = self.c_max[0] * h[0] + self.c_max[1] * h[1] <= LINEARISED_MAX_M;
+        let m_max = self.m_max(h);
+        let (linearise_first, linearise) = (m_max <= NARROW_M, m_max <= WIDE_M);
         let mut scratch = self.scratch.borrow_mut();
         let [zlo, zhi, zc, rz] = &mut *scratch;
-        let mags = self.fill_cell(lo, hi, linearise.then_some(h), [zlo, zhi, zc, rz]);
+        let w_hi = self.fill_cell(lo, hi, linearise.then_some(h), [zlo, zhi, zc, rz]);
         // The box of the centred amplitude over the cell: the shift is linear in a and b.
         let shifts = [
             self.shift(a0, b0),
@@ -310,8 +312,11 @@ impl Landscape for PowerLaw {
         let wa = (a1 - a0) * self.sens[0];
         let wb = (b1 - b0) * self.sens[1];
         let loose = [wa * wa, wb * wb];
-        let mut lb = f64::NEG_INFINITY;
-        if linearise {
+        let linearised = |zlo: &[f64], zhi: &[f64], zc: &[f64], rz: &[f64]| {
+            // sum w a_k^2 for the gradient coefficients a of linearized::Cell::mags: zc <= zhi
+            // and rz <= R zhi with R the remainder's bound at max M.
+            let r = linearized::remainder_bound(m_max, (m_max.exp()) * (1.0 + 1e-15));
+            let f = 1.0 + 1e-9;
             let cell = linearized::Cell {
                 y: &self.y,
                 w: &self.w,
@@ -325,22 +330,35 @@ impl Landscape for PowerLaw {
                 ends,
                 start: self.start_amplitude(lo, hi),
                 wy2: self.wy2,
-                mags,
+                mags: [
+                    w_hi * f,
+                    w_hi * f * (1.0 + linearized::EPS + r).powi(2),
+                    w_hi * f * self.c_max[0].powi(2),
+                    w_hi * f * self.c_max[1].powi(2),
+                ],
             };
-            // A NaN (sums that overflowed) gives no bound: the first-order one reports it.
-            let l = linearized::bound(&cell, target, self.bound_tol);
-            if l > lb {
-                lb = l;
-            }
-        }
-        if !(lb >= target) {
-            let first = if sums::is_large(self.n) {
+            linearized::bound(&cell, target, self.bound_tol)
+        };
+        let first_order = |zlo: &[f64], zhi: &[f64]| {
+            if sums::is_large(self.n) {
                 self.bound_from_inside(zlo, zhi, ends, target)
             } else {
                 self.first_order(zlo, zhi, ends, target)
-            };
-            // A NaN bound (overflow) is passed on for the search to report.
-            lb = if first.is_nan() { first } else { lb.max(first) };
+            }
+        };
+        // Narrow cells: the linearised bound alone. Wide ones: the first-order bound, then the
+        // linearised one where that did not decide. A NaN (overflow) from the first-order bound
+        // is passed on for the search to report; one from the linearised bound gives no bound.
+        let mut lb = if linearise_first {
+            linearised(zlo, zhi, zc, rz)
+        } else {
+            first_order(zlo, zhi)
+        };
+        if !linearise_first && linearise && lb < target {
+            let l = linearised(zlo, zhi, zc, rz);
+            if l > lb {
+                lb = l;
+            }
         }
         // chi2 >= 0 always.
         Bound {
@@ -368,77 +386,70 @@ impl PowerLaw {
     }
 
     /// The scratch arrays of the cell between rows `lo` and `hi`: zlo and zhi (widened by
-    /// Z_SLACK), and with the half-widths `h` the centre's zc and the remainder zc R(M) of
-    /// [`linearized`] (exp(M) from the rows' ratios, no exp per point); returns the sums of
-    /// [`linearized::magnitudes`] (zero without `h`).
+    /// Z_SLACK), and with the half-widths `h` the centre's zc and the remainder zc R(M_i) of
+    /// [`linearized`] (R's bound taking exp(M_i) <= exp(max M), no exp per point); returns
+    /// sum_i w_i zhi_i^2 (0 without `h`).
     fn fill_cell(
         &self,
         lo: [usize; 2],
         hi: [usize; 2],
         h: Option<[f64; 2]>,
         out: [&mut Vec<f64>; 4],
-    ) -> [f64; 4] {
+    ) -> f64 {
         let (za0, za1) = (self.row(0, lo[0]), self.row(0, hi[0]));
         let (zb0, zb1) = (self.row(1, lo[1]), self.row(1, hi[1]));
         let (c1, c2, w) = (&self.c1[..], &self.c2[..], &self.w[..]);
-        let point = |i: usize, o: [&mut f64; 4], m: &mut [f64; 4]| {
+        let e_max = h.map_or(0.0, |h| self.m_max(h).exp() * (1.0 + 1e-15));
+        let point = |i: usize, o: [&mut f64; 4]| -> f64 {
             let (amin, amax) = (za0[i].min(za1[i]), za0[i].max(za1[i]));
             let (bmin, bmax) = (zb0[i].min(zb1[i]), zb0[i].max(zb1[i]));
             let zhi = amax * bmax * (1.0 + Z_SLACK);
             *o[0] = amin * bmin * (1.0 - Z_SLACK);
             *o[1] = zhi;
             let Some([ha, hb]) = h else {
-                return;
+                return 0.0;
             };
-            // exp(-a_c c1) = sqrt(exp(-a0 c1) exp(-a1 c1)); the product of two rows can
+            // exp(-a_c c1 + b_c c2) = sqrt of the product of the corners' rows, which can
             // overflow where the rows do not: then a square root each.
-            let mut zc = (za0[i] * za1[i]).sqrt() * (zb0[i] * zb1[i]).sqrt();
+            let mut zc = (za0[i] * za1[i] * (zb0[i] * zb1[i])).sqrt();
             if !(zc.is_finite() && zc > 0.0) {
                 zc = (amin.sqrt() * amax.sqrt()) * (bmin.sqrt() * bmax.sqrt());
             }
-            let e_m = (amax / amin).sqrt() * (bmax / bmin).sqrt();
-            let rz = zc * linearized::remainder_bound(c1[i].abs() * ha + c2[i].abs() * hb, e_m);
+            let m = c1[i].abs() * ha + c2[i].abs() * hb;
             *o[2] = zc;
-            *o[3] = rz;
-            let t = linearized::magnitudes(w[i], zhi, zc, rz, c1[i], c2[i]);
-            for k in 0..4 {
-                m[k] += t[k];
-            }
+            *o[3] = zc * linearized::remainder_bound(m, e_max);
+            w[i] * zhi * zhi
         };
         let [o0, o1, o2, o3] = out;
-        let mut mags = [0.0; 4];
         if !sums::is_large(self.n) {
+            let mut s = 0.0;
             for i in 0..self.n {
-                point(
-                    i,
-                    [&mut o0[i], &mut o1[i], &mut o2[i], &mut o3[i]],
-                    &mut mags,
-                );
+                s += point(i, [&mut o0[i], &mut o1[i], &mut o2[i], &mut o3[i]]);
             }
-            return mags;
+            return s;
         }
         // Chunks in parallel, their sums added in chunk order (as in [`sums::sum`]).
-        let parts: Vec<[f64; 4]> = o0
+        let parts: Vec<f64> = o0
             .par_chunks_mut(sums::CHUNK)
             .zip(o1.par_chunks_mut(sums::CHUNK))
             .zip(o2.par_chunks_mut(sums::CHUNK))
             .zip(o3.par_chunks_mut(sums::CHUNK))
             .enumerate()
             .map(|(c, (((p0, p1), p2), p3))| {
-                let mut m = [0.0; 4];
+                let mut s = 0.0;
                 for j in 0..p0.len() {
                     let o = [&mut p0[j], &mut p1[j], &mut p2[j], &mut p3[j]];
-                    point(c * sums::CHUNK + j, o, &mut m);
+                    s += point(c * sums::CHUNK + j, o);
                 }
-                m
+                s
             })
             .collect();
-        for p in parts {
-            for k in 0..4 {
-                mags[k] += p[k];
-            }
-        }
-        mags
+        parts.iter().sum()
+    }
+
+    /// The largest M_i = |c1_i| h_a + |c2_i| h_b over the points.
+    fn m_max(&self, h: [f64; 2]) -> f64 {
+        self.c_max[0] * h[0] + self.c_max[1] * h[1]
     }
 
     /// The first-order bound for small data (module doc of the parent): the tangents' crossing

@@ -73,20 +73,9 @@ pub(super) struct Cell<'a> {
     pub start: f64,
     /// sum_i w_i y_i^2.
     pub wy2: f64,
-    /// sum_i w_i zhi_i^2 and sum_i w_i a_ik^2 over the largest gradient coefficients a_i of
-    /// either end, ((1 + EPS) zhi_i + rz_i, zc_i c1_i, zc_i c2_i) (see [`magnitudes`]).
+    /// Upper bounds of sum_i w_i zhi_i^2 and of sum_i w_i a_ik^2 over the largest gradient
+    /// coefficients a_i of either end, ((1 + EPS) zhi_i + rz_i, zc_i c1_i, zc_i c2_i).
     pub mags: [f64; 4],
-}
-
-/// Point i's terms of [`Cell::mags`].
-pub(super) fn magnitudes(w: f64, zhi: f64, zc: f64, rz: f64, c1: f64, c2: f64) -> [f64; 4] {
-    let a0 = (1.0 + EPS) * zhi + rz;
-    [
-        w * zhi * zhi,
-        w * a0 * a0,
-        w * (zc * c1).powi(2),
-        w * (zc * c2).powi(2),
-    ]
 }
 
 /// An upper bound of R(M) = exp(M) - 1 - M from M >= 0 and exp(M) (e_m): the Taylor series
