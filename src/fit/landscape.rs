@@ -273,7 +273,22 @@ mod tests {
                     l.add_row(k, lo[k]).unwrap();
                     l.add_row(k, hi[k]).unwrap();
                 }
-                l.bound([0, 0], [1, 1], f64::NEG_INFINITY).lb
+                // Iterative bounds stop once their relation to the target is decided: the lowest
+                // over several targets, before the corners' nodes are known (the linearised
+                // bound then starts from A = 0) and after (from the corners' amplitude).
+                let at = |l: &PowerLaw, t: f64| l.bound([0, 0], [1, 1], t).lb;
+                let mut b = at(&l, f64::NEG_INFINITY).min(at(&l, f64::INFINITY));
+                let corners = [[0, 0], [1, 0], [0, 1], [1, 1]].map(|r| l.node(r));
+                let corner = corners.iter().cloned().fold(f64::INFINITY, f64::min);
+                for t in [
+                    f64::NEG_INFINITY,
+                    corner,
+                    corner * (1.0 - 1e-3),
+                    f64::INFINITY,
+                ] {
+                    b = b.min(at(&l, t));
+                }
+                b
             } else {
                 let active = [kind != ModelKind::Pm, kind != ModelKind::Vm];
                 let mut l = Separable::new(&obj, kind == ModelKind::Min, active);
@@ -324,15 +339,13 @@ mod tests {
             ModelKind::Min,
             &[([e - 0.01, s - 0.01], [e + 0.02, s + 0.005])],
         );
-        check_bounds_on(
-            &d,
-            ModelKind::PowerLaw,
-            &[
-                ([0.3, 0.1], [0.7, 0.5]),
-                ([-3.0, 2.0], [1.0, 4.0]),
-                ([0.49, 0.29], [0.51, 0.31]),
-            ],
-        );
+        let mut cells = vec![
+            ([0.3, 0.1], [0.7, 0.5]),
+            ([-3.0, 2.0], [1.0, 4.0]),
+            ([0.49, 0.29], [0.51, 0.31]),
+        ];
+        cells.extend(powerlaw_cells(&[1e-5, 0.01, 0.2, 1.0]));
+        check_bounds_on(&d, ModelKind::PowerLaw, &cells);
     }
 
     #[test]
@@ -352,13 +365,34 @@ mod tests {
         ] {
             check_bounds(kind, &cells);
         }
-        check_bounds(
-            ModelKind::PowerLaw,
-            &[
-                ([0.3, 0.1], [0.7, 0.5]),
-                ([-3.0, 2.0], [1.0, 4.0]),
-                ([0.49, 0.29], [0.51, 0.31]),
-            ],
-        );
+        let mut cells = vec![
+            ([0.3, 0.1], [0.7, 0.5]),
+            ([-3.0, 2.0], [1.0, 4.0]),
+            ([0.49, 0.29], [0.51, 0.31]),
+        ];
+        cells.extend(powerlaw_cells(&[1e-6, 1e-3, 0.02, 0.1, 0.3, 0.7, 2.0]));
+        check_bounds(ModelKind::PowerLaw, &cells);
+    }
+
+    /// Power-law cells from tiny to wide (half-widths `h`, the two axes' in ratio 1 and 1/3)
+    /// around centres near this data's minimum (a ~ 0.4, b ~ 0.5 on the pattern), off it and at
+    /// the box's edge: the linearised bound on narrow cells, both bounds on wider ones.
+    fn powerlaw_cells(h: &[f64]) -> Vec<([f64; 2], [f64; 2])> {
+        let centres = [
+            [0.4, 0.5],
+            [0.43, 0.37],
+            [-1.0, 2.0],
+            [2.5, -0.5],
+            [9.0, -9.0],
+        ];
+        let mut out = Vec::new();
+        for c in centres {
+            for &h in h {
+                for (ha, hb) in [(h, h), (h, h / 3.0), (h / 3.0, h)] {
+                    out.push(([c[0] - ha, c[1] - hb], [c[0] + ha, c[1] + hb]));
+                }
+            }
+        }
+        out
     }
 }

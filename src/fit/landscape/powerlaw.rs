@@ -17,8 +17,10 @@ const Z_SLACK: f64 = 1e-12;
 /// Newton or bisection steps per cell bound of the power law (each one pass over the points).
 const POWERLAW_BOUND_ITERS: usize = 30;
 /// On cells where every point's exponent varies by at most NARROW_M (max_i M_i, see
-/// [`linearized`]) the linearised bound is used alone; on cells up to WIDE_M after the
-/// first-order one when that did not decide; wider cells use the first-order bound alone.
+/// [`linearized`]) the linearised bound is tried first, then the first-order one if that did
+/// not decide; on cells up to WIDE_M the other way round; wider cells use the first-order bound
+/// alone (the linearised one's remainder, about M^2 / 2, is then wider than the first-order
+/// range).
 const NARROW_M: f64 = 1.0;
 const WIDE_M: f64 = 4.0;
 
@@ -346,18 +348,24 @@ impl Landscape for PowerLaw {
                 self.first_order(zlo, zhi, ends, target)
             }
         };
-        // Narrow cells: the linearised bound alone. Wide ones: the first-order bound, then the
-        // linearised one where that did not decide. A NaN (overflow) from the first-order bound
-        // is passed on for the search to report; one from the linearised bound gives no bound.
-        let mut lb = if linearise_first {
-            linearised(zlo, zhi, zc, rz)
+        // Narrow cells: the linearised bound first; wide ones: the first-order bound first. The
+        // other (not on the widest cells) when the first did not decide: the larger is kept. A
+        // NaN (overflow) from the first-order bound is passed on for the search to report; one
+        // from the linearised bound gives no bound.
+        let mut lb;
+        if linearise_first {
+            lb = linearised(zlo, zhi, zc, rz);
+            if !(lb >= target) {
+                let first = first_order(zlo, zhi);
+                lb = if first.is_nan() { first } else { lb.max(first) };
+            }
         } else {
-            first_order(zlo, zhi)
-        };
-        if !linearise_first && linearise && lb < target {
-            let l = linearised(zlo, zhi, zc, rz);
-            if l > lb {
-                lb = l;
+            lb = first_order(zlo, zhi);
+            if linearise && !(lb >= target) {
+                let l = linearised(zlo, zhi, zc, rz);
+                if l > lb {
+                    lb = l;
+                }
             }
         }
         // chi2 >= 0 always.
