@@ -20,7 +20,20 @@
 //! for every A, chi2 >= f(A) = sum_i w_i dist(y_i, [A zlo_i, A zhi_i])^2 with y_i = 1 - e_i. f is
 //! convex in A (a sum of squares of positive parts of affine functions), so two points A1 < A2
 //! with f'(A1) <= 0 <= f'(A2) give a valid lower bound of its minimum: the crossing of the
-//! tangents there.
+//! tangents there. That bound loses a share of first order in the cell's width, so near a
+//! minimum cells are split long before it closes; narrower cells get a second-order bound
+//! (`powerlaw/linearized.rs`): with delta = (a, b) minus the cell's centre,
+//! z_i = zc_i exp(m_i), m_i = -c1_i delta_a + c2_i delta_b in [-M_i, M_i], and
+//! exp(m) = 1 + m + R(m) with 0 <= R(m) <= R(M_i), so A z_i lies in
+//! [L_i(x), L_i(x) + A zc_i R(M_i)] with L_i linear in x = (A, A delta_a, A delta_b), and x
+//! ranges over a cone section K (A in its box, |A delta_k| <= A h_k). chi2 >= min over K of the
+//! convex phi(x) = sum_i w_i dist(y_i, that interval)^2, and phi(x) >= phi(x*) + grad phi(x*) .
+//! (x - x*) for any x*, whose minimum over K is at a vertex: exact when x* minimises phi (from
+//! Newton steps, [`super::qp`]). The tangent plane is used over A within a factor 1 +- kappa of
+//! x*'s and f beyond (convex: its value at the slice's end bounds the tail when its slope there
+//! points outwards). Intervals are widened by 1e-12 A zhi_i plus a few ulps of e, and the
+//! bound lowered by the rounding of phi and of its gradient (times the slice's extent). The
+//! cell's bound is the larger of the two where the first tried does not decide.
 
 use super::bnb::{Bound, Landscape};
 use super::objective::Objective;

@@ -28,10 +28,11 @@
 //! EPS A zhi_i (the relative error of the centre's z, of R and of the model's own evaluation,
 //! all below 1e-13) plus a few ulps of e (the objective forms e = 1 - y and e - e_obs); A's box
 //! by EPS relative. The bound's own arithmetic is accounted for: each point's computed distance
-//! is within DELTA (A zhi_i + |y_i|) of the exact one, and a sum of n terms within
-//! GAMMA_PER_POINT n of the sum of their magnitudes (the chunked sums of [`sums`] add at most
-//! 4096 + n / 4096 terms in a row); phi and its gradient are lowered by those margins, the
-//! gradient's times the slice's extent.
+//! is within DELTA (A zhi_i + |y_i|) of the exact one, and a sum of n terms within gamma times
+//! the sum of their magnitudes (gamma about 1.5 u times the terms added in a row: n for small
+//! data, a chunk of 4096 and then the chunks for large, see [`sums`]); these are bounded by
+//! Cauchy-Schwarz from sum w zhi^2 and sum w y^2, and phi is lowered by its margin and the
+//! linear term by the gradient's margin times the slice's extent.
 //!
 //! **Known answer** (test below): on noise-free power-law data a cell holding the true exponents
 //! has a bound of (nearly) 0 and one far from them a bound near chi2's minimum over it; every
