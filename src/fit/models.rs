@@ -301,10 +301,16 @@ impl<'a> Evaluator<'a> {
         super::sums::fill(&mut out[..n], |i| self.e_pm_s25(i, s25));
     }
 
+    /// The power law's e at point `i` for ln A and exponents a, b.
+    fn e_powerlaw(&self, i: usize, ln_a: f64, a: f64, b: f64) -> f64 {
+        1.0 - (ln_a - a * self.powerlaw_ln_d[i] + b * self.powerlaw_ln_v[i]).exp()
+    }
+
     /// Model e at every point for physical parameters `p` (order of [`ModelKind::params`]).
     /// Large data are evaluated in chunks on all cores ([`super::sums`]); each value is computed
     /// alone, and an error is the first failing point's, as in point order.
     pub fn predict(&self, kind: ModelKind, p: &[f64], out: &mut [f64]) -> Result<()> {
+        let n = self.len().min(out.len());
         let s25 = match kind {
             ModelKind::Pm => p[0].powf(2.5),
             ModelKind::Min | ModelKind::Product => p[1].powf(2.5),
@@ -316,13 +322,9 @@ impl<'a> Evaluator<'a> {
                 ModelKind::Pm => self.e_pm_s25(i, s25),
                 ModelKind::Min => self.e_vm(i, p[0])?.min(self.e_pm_s25(i, s25)),
                 ModelKind::Product => self.e_vm(i, p[0])? * self.e_pm_s25(i, s25),
-                ModelKind::PowerLaw => {
-                    1.0 - (p[0].ln() - p[1] * self.powerlaw_ln_d[i] + p[2] * self.powerlaw_ln_v[i])
-                        .exp()
-                }
+                ModelKind::PowerLaw => self.e_powerlaw(i, p[0].ln(), p[1], p[2]),
             })
         };
-        let n = self.len().min(out.len());
         let chunk = |start: usize, slots: &mut [f64]| -> Result<()> {
             for (j, slot) in slots.iter_mut().enumerate() {
                 *slot = one(start + j)?;

@@ -5,13 +5,25 @@ use super::super::bnb::{Bound, Landscape};
 use super::super::models::{POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S, powerlaw_d_mm};
 use super::super::objective::Objective;
 use super::super::sums;
+use rayon::prelude::*;
 use std::cell::RefCell;
+use std::collections::HashMap;
+
+mod first_order;
+mod linearized;
 
 /// Relative widening of the z ranges of the power law: a few rounding errors of exp and a
 /// product (1e-12 is 4500 ulp).
 const Z_SLACK: f64 = 1e-12;
 /// Newton or bisection steps per cell bound of the power law (each one pass over the points).
 const POWERLAW_BOUND_ITERS: usize = 30;
+/// On cells where every point's exponent varies by at most NARROW_M (max_i M_i, see
+/// [`linearized`]) the linearised bound is tried first, then the first-order one if that did
+/// not decide; on cells up to WIDE_M the other way round; wider cells use the first-order bound
+/// alone (the linearised one's remainder, about M^2 / 2, is then wider than the first-order
+/// range).
+const NARROW_M: f64 = 1.0;
+const WIDE_M: f64 = 4.0;
 
 /// The power law's landscape over (a, b), A profiled out.
 pub struct PowerLaw {
@@ -33,9 +45,17 @@ pub struct PowerLaw {
     sens: [f64; 2],
     /// How close to its minimum a cell bound is computed (efficiency only: any stop is valid).
     pub bound_tol: f64,
-    /// The z ranges of the last cell bound, kept so that each bound does not allocate (and, for
-    /// large data, fault in) two fresh arrays of the points.
-    scratch: RefCell<(Vec<f64>, Vec<f64>)>,
+    /// max_i |c1_i| and max_i |c2_i|.
+    c_max: [f64; 2],
+    /// The z ranges (zlo, zhi), centre values zc and remainders zc R of the last cell bound
+    /// (see [`linearized`]), kept so that each bound does not allocate (and, for large data,
+    /// fault in) fresh arrays of the points.
+    scratch: RefCell<[Vec<f64>; 4]>,
+    /// The centred amplitude minimising chi2 at each node evaluated (a start for the cells'
+    /// bounds).
+    amplitudes: RefCell<HashMap<[usize; 2], f64>>,
+    /// sum_i w_i y_i^2.
+    wy2: f64,
 }
 
 impl PowerLaw {
@@ -55,6 +75,7 @@ impl PowerLaw {
         let m1 = x1.iter().sum::<f64>() / n as f64;
         let m2 = x2.iter().sum::<f64>() / n as f64;
         let w: Vec<f64> = obj.inv_sigma.iter().map(|s| s * s).collect();
+        let wy2 = (0..n).map(|i| w[i] * (1.0 - data.obs[i].e).powi(2)).sum();
         let wmax = w.iter().cloned().fold(0.0, f64::max);
         PowerLaw {
             n,
@@ -71,6 +92,10 @@ impl PowerLaw {
                     .sqrt(),
             ],
             w,
+            c_max: [
+                x1.iter().map(|x| (x - m1).abs()).fold(0.0, f64::max),
+                x2.iter().map(|x| (x - m2).abs()).fold(0.0, f64::max),
+            ],
             c1: x1.iter().map(|x| x - m1).collect(),
             c2: x2.iter().map(|x| x - m2).collect(),
             m1,
@@ -79,7 +104,9 @@ impl PowerLaw {
             rows: [Vec::new(), Vec::new()],
             t: [Vec::new(), Vec::new()],
             bound_tol: 0.0,
-            scratch: RefCell::new((vec![0.0; n], vec![0.0; n])),
+            scratch: RefCell::new([vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]]),
+            amplitudes: RefCell::new(HashMap::new()),
+            wy2,
         }
     }
 
@@ -130,108 +157,6 @@ impl PowerLaw {
         });
         (ac.ln() - s, chi2)
     }
-
-    /// f(A), f'(A) and f''(A) (from the right) of the module doc. Branch-free (selects), so it
-    /// vectorises; every input is finite (rows are checked when they are made).
-    fn f_slope_curv(&self, zlo: &[f64], zhi: &[f64], a: f64) -> (f64, f64, f64) {
-        let (y, w) = (&self.y[..], &self.w[..]);
-        let [f, d, h] = sums::sum(self.n, |points| {
-            let (mut f, mut d, mut h) = (0.0, 0.0, 0.0);
-            for i in points {
-                let w = w[i];
-                let u = a * zlo[i] - y[i];
-                let v = y[i] - a * zhi[i];
-                // At most one of u, v is positive (zlo <= zhi).
-                let pu = if u > 0.0 { u } else { 0.0 };
-                let pv = if v > 0.0 { v } else { 0.0 };
-                let cu = if u > 0.0 { zlo[i] } else { 0.0 };
-                let cv = if v > 0.0 { zhi[i] } else { 0.0 };
-                f += w * (pu * pu + pv * pv);
-                d += 2.0 * w * (zlo[i] * pu - zhi[i] * pv);
-                h += 2.0 * w * (cu * cu + cv * cv);
-            }
-            [f, d, h]
-        });
-        (f, d, h)
-    }
-}
-
-impl PowerLaw {
-    /// The least-squares amplitude A with every point's z at the middle of its range: the start
-    /// of both bound iterations.
-    fn amplitude_at_middle(&self, zlo: &[f64], zhi: &[f64]) -> f64 {
-        let (y, w) = (&self.y[..], &self.w[..]);
-        let [num, den] = sums::sum(self.n, |points| {
-            let (mut num, mut den) = (0.0, 0.0);
-            for i in points {
-                let z = 0.5 * (zlo[i] + zhi[i]);
-                num += w[i] * z * y[i];
-                den += w[i] * z * z;
-            }
-            [num, den]
-        });
-        num / den
-    }
-
-    /// The minimum of f over the box of A, bounded below as in [`Landscape::bound`] for small
-    /// data, but starting from the least-squares A at the middle z and evaluating the box's ends
-    /// only when a step leaves the bracket: near the minimum (where nearly all cells are) the
-    /// two evaluations at the ends of a box of decades were a third of the work. Any two
-    /// tangents with slopes of opposite signs cross below the minimum of the convex f; a slope
-    /// of the wrong sign at a box end puts the minimum over the box there. Without both kinds of
-    /// tangent after the iterations, -inf (no bound: the cell is split).
-    fn bound_from_inside(&self, zlo: &[f64], zhi: &[f64], ends: (f64, f64), target: f64) -> f64 {
-        let mut x = self.amplitude_at_middle(zlo, zhi);
-        // The latest points with f' < 0 (left of the minimum) and f' > 0 (right of it).
-        let mut left: Option<(f64, f64, f64)> = None;
-        let mut right: Option<(f64, f64, f64)> = None;
-        let mut lb = f64::NEG_INFINITY;
-        for _ in 0..POWERLAW_BOUND_ITERS {
-            let l = left.map_or(ends.0, |p| p.0);
-            let r = right.map_or(ends.1, |p| p.0);
-            if !(x > l && x < r) {
-                x = if x <= l && left.is_none() {
-                    ends.0
-                } else if x >= r && right.is_none() {
-                    ends.1
-                } else if l > 0.0 {
-                    (l * r).sqrt()
-                } else {
-                    0.5 * (l + r)
-                };
-            }
-            let (f, d, h) = self.f_slope_curv(zlo, zhi, x);
-            if d == 0.0 || f == 0.0 {
-                return f;
-            }
-            if d < 0.0 {
-                if x == ends.1 {
-                    return f;
-                }
-                left = Some((x, f, d));
-            } else {
-                if x == ends.0 {
-                    return f;
-                }
-                right = Some((x, f, d));
-            }
-            let step = d / h;
-            if let (Some((x1, f1, d1)), Some((x2, f2, d2))) = (left, right) {
-                let xc = (f2 - f1 + d1 * x1 - d2 * x2) / (d1 - d2);
-                lb = f1 + d1 * (xc - x1);
-                // Decided (as for small data).
-                if lb >= target || f1.min(f2) < target || f1.min(f2) - lb <= self.bound_tol {
-                    break;
-                }
-                x -= step;
-            } else {
-                // One side only: a Newton step a little long, to reach the other side (f' is
-                // piecewise linear, so an exact step lands on the minimum itself).
-                x -= step * (1.0 + 1e-3);
-            }
-        }
-        lb
-    }
 }
 
 impl Landscape for PowerLaw {
@@ -253,23 +178,28 @@ impl Landscape for PowerLaw {
     }
 
     fn node(&self, r: [usize; 2]) -> f64 {
-        self.profile(r).1
+        let (ln_a, chi2) = self.profile(r);
+        let (a, b) = (self.t[0][r[0]], self.t[1][r[1]]);
+        self.amplitudes
+            .borrow_mut()
+            .insert(r, (ln_a + self.shift(a, b)).exp());
+        chi2
     }
 
     fn bound(&self, lo: [usize; 2], hi: [usize; 2], target: f64) -> Bound {
-        let (za0, za1) = (self.row(0, lo[0]), self.row(0, hi[0]));
-        let (zb0, zb1) = (self.row(1, lo[1]), self.row(1, hi[1]));
-        let mut scratch = self.scratch.borrow_mut();
-        let (zlo, zhi) = &mut *scratch;
-        sums::fill(zlo, |i| {
-            za0[i].min(za1[i]) * zb0[i].min(zb1[i]) * (1.0 - Z_SLACK)
-        });
-        sums::fill(zhi, |i| {
-            za0[i].max(za1[i]) * zb0[i].max(zb1[i]) * (1.0 + Z_SLACK)
-        });
-        // The box of the centred amplitude over the cell: the shift is linear in a and b.
         let (a0, a1) = (self.t[0][lo[0]], self.t[0][hi[0]]);
         let (b0, b1) = (self.t[1][lo[1]], self.t[1][hi[1]]);
+        // Half-widths rounded up (a difference and a halving, each within an ulp).
+        let h = [
+            0.5 * (a1 - a0) * (1.0 + 1e-15),
+            0.5 * (b1 - b0) * (1.0 + 1e-15),
+        ];
+        let m_max = self.m_max(h);
+        let (linearise_first, linearise) = (m_max <= NARROW_M, m_max <= WIDE_M);
+        let mut scratch = self.scratch.borrow_mut();
+        let [zlo, zhi, zc, rz] = &mut *scratch;
+        let w_hi = self.fill_cell(lo, hi, linearise.then_some(h), [zlo, zhi, zc, rz]);
+        // The box of the centred amplitude over the cell: the shift is linear in a and b.
         let shifts = [
             self.shift(a0, b0),
             self.shift(a1, b0),
@@ -278,69 +208,154 @@ impl Landscape for PowerLaw {
         ];
         let smin = shifts.iter().cloned().fold(f64::INFINITY, f64::min);
         let smax = shifts.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
-        let (mut x1, mut x2) = (self.a_range.0 * smin.exp(), self.a_range.1 * smax.exp());
+        let ends = (self.a_range.0 * smin.exp(), self.a_range.1 * smax.exp());
         // How much each axis loosens the bound: its width times the model's sensitivity to it.
         let wa = (a1 - a0) * self.sens[0];
         let wb = (b1 - b0) * self.sens[1];
-        let loose = |_: f64| [wa * wa, wb * wb];
-        if sums::is_large(self.n) {
-            let lb = self.bound_from_inside(zlo, zhi, (x1, x2), target);
-            // chi2 >= 0 always; a NaN bound (overflow) is passed on for the search to report.
-            return Bound {
-                lb: if lb < 0.0 { 0.0 } else { lb },
-                loose: loose(0.0),
+        let loose = [wa * wa, wb * wb];
+        let linearised = |zlo: &[f64], zhi: &[f64], zc: &[f64], rz: &[f64]| {
+            // sum w a_k^2 for the gradient coefficients a of linearized::Cell::mags: zc <= zhi
+            // and rz <= R zhi with R the remainder's bound at max M.
+            let r = linearized::remainder_bound(m_max, (m_max.exp()) * (1.0 + 1e-15));
+            let f = 1.0 + 1e-9;
+            let cell = linearized::Cell {
+                y: &self.y,
+                w: &self.w,
+                c1: &self.c1,
+                c2: &self.c2,
+                zlo,
+                zhi,
+                zc,
+                rz,
+                h,
+                ends,
+                start: self.start_amplitude(lo, hi),
+                wy2: self.wy2,
+                mags: [
+                    w_hi * f,
+                    w_hi * f * (1.0 + linearized::EPS + r).powi(2),
+                    w_hi * f * self.c_max[0].powi(2),
+                    w_hi * f * self.c_max[1].powi(2),
+                ],
             };
-        }
-        let (mut f1, mut d1, _) = self.f_slope_curv(zlo, zhi, x1);
-        if d1 >= 0.0 {
-            return Bound {
-                lb: f1,
-                loose: loose(x1),
-            };
-        }
-        let (mut f2, mut d2, _) = self.f_slope_curv(zlo, zhi, x2);
-        if d2 <= 0.0 {
-            return Bound {
-                lb: f2,
-                loose: loose(x2),
-            };
-        }
-        // f'(x1) < 0 < f'(x2): the tangents' crossing is a lower bound. Newton steps on the
-        // piecewise linear f' (exact on each piece) move the bracket in; bisection (geometric, A
-        // spans decades) when a step leaves it. Start from the least-squares A at the middle z.
-        let mut x = self.amplitude_at_middle(zlo, zhi);
-        let mut lb = f64::NEG_INFINITY;
-        for _ in 0..POWERLAW_BOUND_ITERS {
-            if !(x > x1 && x < x2) {
-                x = if x1 > 0.0 {
-                    (x1 * x2).sqrt()
-                } else {
-                    0.5 * (x1 + x2)
-                };
-            }
-            let (f, d, h) = self.f_slope_curv(zlo, zhi, x);
-            if d == 0.0 || f == 0.0 {
-                lb = f;
-                break;
-            }
-            if d < 0.0 {
-                (x1, f1, d1) = (x, f, d);
+            linearized::bound(&cell, target, self.bound_tol)
+        };
+        let first_order = |zlo: &[f64], zhi: &[f64]| {
+            if sums::is_large(self.n) {
+                self.bound_from_inside(zlo, zhi, ends, target)
             } else {
-                (x2, f2, d2) = (x, f, d);
+                self.first_order(zlo, zhi, ends, target)
             }
-            let xc = (f2 - f1 + d1 * x1 - d2 * x2) / (d1 - d2);
-            lb = f1 + d1 * (xc - x1);
-            // Decided: the cell is excluded (lb above the target), or it holds a point below
-            // the target (so it will be split whatever the bound), or the bound is tight.
-            if lb >= target || f1.min(f2) < target || f1.min(f2) - lb <= self.bound_tol {
-                break;
+        };
+        // Narrow cells: the linearised bound first; wide ones: the first-order bound first. The
+        // other (not on the widest cells) when the first did not decide: the larger is kept. A
+        // NaN (overflow) from the first-order bound is passed on for the search to report; one
+        // from the linearised bound gives no bound.
+        let mut lb;
+        if linearise_first {
+            lb = linearised(zlo, zhi, zc, rz);
+            if !(lb >= target) {
+                let first = first_order(zlo, zhi);
+                lb = if first.is_nan() { first } else { lb.max(first) };
             }
-            x -= d / h;
+        } else {
+            lb = first_order(zlo, zhi);
+            if linearise && !(lb >= target) {
+                let l = linearised(zlo, zhi, zc, rz);
+                if l > lb {
+                    lb = l;
+                }
+            }
         }
-        // chi2 >= 0 always; a NaN bound (overflow) is passed on for the search to report.
+        // chi2 >= 0 always.
         Bound {
             lb: if lb < 0.0 { 0.0 } else { lb },
-            loose: loose(0.5 * (x1 + x2)),
+            loose,
         }
+    }
+}
+
+impl PowerLaw {
+    /// The geometric mean of the amplitudes at the cell's corners (0 when none is known).
+    fn start_amplitude(&self, lo: [usize; 2], hi: [usize; 2]) -> f64 {
+        let amps = self.amplitudes.borrow();
+        let corners = [lo, [hi[0], lo[1]], [lo[0], hi[1]], hi];
+        let logs: Vec<f64> = corners
+            .iter()
+            .filter_map(|r| amps.get(r))
+            .filter(|a| a.is_finite() && **a > 0.0)
+            .map(|a| a.ln())
+            .collect();
+        if logs.is_empty() {
+            return 0.0;
+        }
+        (logs.iter().sum::<f64>() / logs.len() as f64).exp()
+    }
+
+    /// The scratch arrays of the cell between rows `lo` and `hi`: zlo and zhi (widened by
+    /// Z_SLACK), and with the half-widths `h` the centre's zc and the remainder zc R(M_i) of
+    /// [`linearized`] (R's bound taking exp(M_i) <= exp(max M), no exp per point); returns
+    /// sum_i w_i zhi_i^2 (0 without `h`).
+    fn fill_cell(
+        &self,
+        lo: [usize; 2],
+        hi: [usize; 2],
+        h: Option<[f64; 2]>,
+        out: [&mut Vec<f64>; 4],
+    ) -> f64 {
+        let (za0, za1) = (self.row(0, lo[0]), self.row(0, hi[0]));
+        let (zb0, zb1) = (self.row(1, lo[1]), self.row(1, hi[1]));
+        let (c1, c2, w) = (&self.c1[..], &self.c2[..], &self.w[..]);
+        let e_max = h.map_or(0.0, |h| self.m_max(h).exp() * (1.0 + 1e-15));
+        let point = |i: usize, o: [&mut f64; 4]| -> f64 {
+            let (amin, amax) = (za0[i].min(za1[i]), za0[i].max(za1[i]));
+            let (bmin, bmax) = (zb0[i].min(zb1[i]), zb0[i].max(zb1[i]));
+            let zhi = amax * bmax * (1.0 + Z_SLACK);
+            *o[0] = amin * bmin * (1.0 - Z_SLACK);
+            *o[1] = zhi;
+            let Some([ha, hb]) = h else {
+                return 0.0;
+            };
+            // exp(-a_c c1 + b_c c2) = sqrt of the product of the corners' rows, which can
+            // overflow where the rows do not: then a square root each.
+            let mut zc = (za0[i] * za1[i] * (zb0[i] * zb1[i])).sqrt();
+            if !(zc.is_finite() && zc > 0.0) {
+                zc = (amin.sqrt() * amax.sqrt()) * (bmin.sqrt() * bmax.sqrt());
+            }
+            let m = c1[i].abs() * ha + c2[i].abs() * hb;
+            *o[2] = zc;
+            *o[3] = zc * linearized::remainder_bound(m, e_max);
+            w[i] * zhi * zhi
+        };
+        let [o0, o1, o2, o3] = out;
+        if !sums::is_large(self.n) {
+            let mut s = 0.0;
+            for i in 0..self.n {
+                s += point(i, [&mut o0[i], &mut o1[i], &mut o2[i], &mut o3[i]]);
+            }
+            return s;
+        }
+        // Chunks in parallel, their sums added in chunk order (as in [`sums::sum`]).
+        let parts: Vec<f64> = o0
+            .par_chunks_mut(sums::CHUNK)
+            .zip(o1.par_chunks_mut(sums::CHUNK))
+            .zip(o2.par_chunks_mut(sums::CHUNK))
+            .zip(o3.par_chunks_mut(sums::CHUNK))
+            .enumerate()
+            .map(|(c, (((p0, p1), p2), p3))| {
+                let mut s = 0.0;
+                for j in 0..p0.len() {
+                    let o = [&mut p0[j], &mut p1[j], &mut p2[j], &mut p3[j]];
+                    s += point(c * sums::CHUNK + j, o);
+                }
+                s
+            })
+            .collect();
+        parts.iter().sum()
+    }
+
+    /// The largest M_i = |c1_i| h_a + |c2_i| h_b over the points.
+    fn m_max(&self, h: [f64; 2]) -> f64 {
+        self.c_max[0] * h[0] + self.c_max[1] * h[1]
     }
 }
