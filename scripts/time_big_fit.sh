@@ -3,9 +3,9 @@
 # share a pair geometry and a speed, merged exactly by the fit), and the same rows with every
 # speed moved by up to 0.1% (100 000 distinct points: the certified search's cost grows with
 # them; above 16384 points its sums run on both cores, so wall time depends on the machine's
-# load). Quoted in the README (fuzzing; known limitations). The distinct-speed powerlaw fit
-# took about 40 s with the first-order cell bound alone (22 680 cells) and 3.5-4.3 s of CPU with
-# the linearised bound (294 cells; docs/physics.md §7.4), on a shared, loaded machine.
+# load). Quoted in the README (fuzzing; known limitations). With the first-order cell bounds
+# alone the distinct-speed fits took 2.3 (vm) to 33 s (powerlaw) of CPU; with the second-order
+# bounds (docs/physics.md §7.4) 0.4-5.2 s.
 #
 # Usage: bash scripts/time_big_fit.sh [BINARY]   (default target/release/restitution)
 set -euo pipefail
