@@ -242,7 +242,9 @@ pub(super) fn bound(c: &Cell, target: f64, tol: f64) -> f64 {
     let scale = [1.0, ha, hb];
     // From the guess at the centre (P = Q = 0), or from A = 0 (where the first step is the
     // least-squares fit of every point's upper end).
-    let guess = c.start.clamp(ends.0, ends.1);
+    // max/min, not clamp: clamp panics on a NaN end (0 x inf where the box of A meets an
+    // overflowing shift), and a NaN end must reach the bound (a failed cell), not abort.
+    let guess = c.start.max(ends.0).min(ends.1);
     let mut x = [if c.start > 0.0 { guess } else { 0.0 }, 0.0, 0.0];
     let first = if x[0] > 0.0 { 0 } else { 1 };
     let mut kappa = KAPPA0;
