@@ -4,7 +4,7 @@
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use restitution::models::plastic::{e_of_u, rebound_u};
 use restitution::models::viscoelastic::{
-    ContactEnd, OdeSettings, VmMethod, restitution, restitution_ode,
+    ContactEnd, OdeSettings, VmMethod, master, restitution, restitution_ode,
 };
 use std::hint::black_box;
 use std::time::Duration;
@@ -18,6 +18,34 @@ fn master_curve(c: &mut Criterion) {
             });
         }
     }
+    g.finish();
+}
+
+/// e(kappa) at 100 000 kappa spread over the table's range (0.01-2, the nylon data's), one at a
+/// time and eight interleaved (`master::e_master_in_place`, what the fit uses): per value,
+/// divide the time by 100 000.
+fn master_curve_many(c: &mut Criterion) {
+    let mut g = c.benchmark_group("master_e_of_kappa_100000");
+    g.measurement_time(Duration::from_secs(3));
+    let kappas: Vec<f64> = (0..100_000)
+        .map(|i| 0.01 + 2.0 * (i as f64 * 0.618_034).fract())
+        .collect();
+    let mut out = vec![0.0; kappas.len()];
+    g.bench_function("one at a time", |b| {
+        b.iter(|| {
+            for (o, &k) in out.iter_mut().zip(black_box(&kappas)) {
+                *o = restitution(k, ContactEnd::Overlap, &VmMethod::Master)
+                    .unwrap()
+                    .e;
+            }
+        })
+    });
+    g.bench_function("eight interleaved", |b| {
+        b.iter(|| {
+            out.copy_from_slice(black_box(&kappas));
+            master::e_master_in_place(&mut out, ContactEnd::Overlap).unwrap();
+        })
+    });
     g.finish();
 }
 
@@ -67,6 +95,7 @@ criterion_group!(
     benches,
     master_curve,
     master_curve_large,
+    master_curve_many,
     ode_default,
     plastic
 );

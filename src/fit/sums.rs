@@ -59,6 +59,19 @@ pub fn fill(out: &mut [f64], f: impl Fn(usize) -> f64 + Sync) {
     });
 }
 
+/// `f(start, out[start..start + len])` over consecutive pieces covering `out`: the whole of it
+/// for small data, chunks of [`CHUNK`] in parallel for large data (for evaluations that work on
+/// several points at once; each value must depend on its point alone).
+pub fn fill_chunks(out: &mut [f64], f: impl Fn(usize, &mut [f64]) + Sync) {
+    if !is_large(out.len()) {
+        f(0, out);
+        return;
+    }
+    out.par_chunks_mut(CHUNK)
+        .enumerate()
+        .for_each(|(c, o)| f(c * CHUNK, o));
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -350,7 +350,7 @@ impl Landscape for Separable<'_> {
         if axis == 1 {
             ev.e_pm_row(x, row);
         } else {
-            sums::fill(row, |i| ev.e_vm(i, x).unwrap_or(f64::NAN));
+            ev.e_vm_row(x, row);
         }
         // The first point that failed names the failure (the evaluation's error if it gave
         // one, else the NaN).
