@@ -351,6 +351,18 @@ impl<'a> Evaluator<'a> {
     /// Large data are evaluated in chunks on all cores ([`super::sums`]); each value is computed
     /// alone, and an error is the first failing point's, as in point order.
     pub fn predict(&self, kind: ModelKind, p: &[f64], out: &mut [f64]) -> Result<()> {
+        self.predict_then(kind, p, out, |_, _| {})
+    }
+
+    /// [`Evaluator::predict`], then `finish(start, values)` on each chunk of values while it is
+    /// still in cache and on its core (the residuals: one pass over the points, not two).
+    pub fn predict_then(
+        &self,
+        kind: ModelKind,
+        p: &[f64],
+        out: &mut [f64],
+        finish: impl Fn(usize, &mut [f64]) + Sync,
+    ) -> Result<()> {
         let n = self.len().min(out.len());
         let s25 = match kind {
             ModelKind::Pm => p[0].powf(2.5),
@@ -385,6 +397,7 @@ impl<'a> Evaluator<'a> {
                     }
                 }
             }
+            finish(start, slots);
             Ok(())
         };
         if !super::sums::is_large(n) {

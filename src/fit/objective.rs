@@ -42,6 +42,8 @@ pub struct Objective<'a> {
     pub fd_step: f64,
     pub evals: Cell<u64>,
     pub inv_sigma: Vec<f64>,
+    /// The points' measured e, contiguous.
+    e: Vec<f64>,
     /// Bound on the error of one evaluation of e (see [`model_accuracy`]).
     pub e_accuracy: f64,
     /// Things the set-up changed and a user should know (a narrowed box).
@@ -66,11 +68,13 @@ impl Residuals for Objective<'_> {
     fn residuals(&self, theta: &[f64], out: &mut [f64]) -> Result<()> {
         self.evals.set(self.evals.get() + 1);
         let p = self.kind.to_physical(theta);
-        self.ev.predict(self.kind, &p, out)?;
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = (*o - self.ev.data.obs[i].e) * self.inv_sigma[i];
-        }
-        Ok(())
+        let (e, inv_sigma) = (&self.e[..], &self.inv_sigma[..]);
+        self.ev.predict_then(self.kind, &p, out, |start, slots| {
+            let at = start..start + slots.len();
+            for ((o, e), w) in slots.iter_mut().zip(&e[at.clone()]).zip(&inv_sigma[at]) {
+                *o = (*o - e) * w;
+            }
+        })
     }
     fn lower(&self) -> &[f64] {
         &self.lower
@@ -105,6 +109,7 @@ impl<'a> Objective<'a> {
             fd_step: fd_step_for(kind, &ev.method),
             evals: Cell::new(0),
             inv_sigma,
+            e: data.obs.iter().map(|o| o.e).collect(),
             e_accuracy: model_accuracy(&ev.method),
             warnings,
             rows: data.len(),
