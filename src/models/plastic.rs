@@ -125,6 +125,38 @@ pub fn rebound_u(u: f64) -> PlasticRebound {
     PlasticRebound { e, one_minus_e }
 }
 
+/// e(u) of [`rebound_u`] and its slope de/d(ln u), for the fit's Jacobian (exact derivatives
+/// cost one pass over the points where central differences cost two per parameter).
+///
+/// With ln e = ln(1 + 1.5 q) - ln u - ln(1 + q)/4 and dq/du = 4u/w (w = sqrt(30 u^2 - 5)):
+/// d ln e/d ln u = u (4u/w) (1.5/(1 + 1.5 q) - 0.25/(1 + q)) - 1, which vanishes as u -> 1+
+/// (e is C^1 at yield); below yield the slope is 0. From [`U_ASYMPTOTE`] on, the derivative of
+/// the large-u form: e (-1/4 + dcorr/d ln u / corr), corr = 1 + A1/u + A2/u^2 + A3/u^3 (just
+/// -e/4 from 1e20 on, where corr is 1 to rounding). Checked against central differences of
+/// [`rebound_u`] in the test below. NaN for NaN u; 0 for u = +inf (e = 0 there).
+pub fn e_and_slope_ln_u(u: f64) -> (f64, f64) {
+    let e = rebound_u(u).e;
+    if u.is_nan() {
+        return (e, f64::NAN);
+    }
+    if u <= 1.0 {
+        return (e, 0.0);
+    }
+    if u >= U_ASYMPTOTE {
+        if u >= 1e20 {
+            return (e, -0.25 * e);
+        }
+        let t = 1.0 / u;
+        let corr = 1.0 + t * (A1 + t * (A2 + t * A3));
+        let dcorr = -t * (A1 + t * (2.0 * A2 + t * 3.0 * A3));
+        return (e, e * (dcorr / corr - 0.25));
+    }
+    let w = (30.0 * u).mul_add(u, -5.0).sqrt();
+    let q = 4.0 * (u - 1.0) * (u + 1.0) / (w + 5.0);
+    let dlne = u * (4.0 * u / w) * (1.5 / (1.0 + 1.5 * q) - 0.25 / (1.0 + q)) - 1.0;
+    (e, e * dlne)
+}
+
 /// [`rebound_u`] for unvalidated u: NaN, negative or infinite u is an error naming it.
 pub fn try_rebound_u(u: f64) -> Result<PlasticRebound> {
     crate::error::non_negative("u = V/V_Y", u)?;
@@ -259,6 +291,40 @@ mod tests {
             "max |e''| = {worst} above {E_CURVATURE_LN_U} / 1.5"
         );
         assert!((worst - 0.48).abs() < 2e-3, "max |e''| = {worst}");
+    }
+
+    #[test]
+    fn slope_in_ln_u_matches_central_differences() {
+        // Against Richardson-extrapolated central differences of rebound_u in t = ln u
+        // (D(h) = (e(t+h) - e(t-h))/2h, (4 D(h/2) - D(h))/3, h = 1e-3: truncation about
+        // h^4 |e^(5)| ~ 1e-12, rounding about 1e-16/h = 1e-13). Tolerance 1e-10 absolute (e and
+        // its slope are at most 1 in size): far above both errors, far below what would show a
+        // wrong term (each term of the formula is of order 0.1-1 over this range).
+        let h = 1e-3;
+        let e = |t: f64| rebound_u(t.exp()).e;
+        let d = |t: f64, h: f64| (e(t + h) - e(t - h)) / (2.0 * h);
+        let mut us: Vec<f64> = (0..400)
+            .map(|k| 10f64.powf(-0.5 + k as f64 * 0.04))
+            .collect();
+        // Either side of the switch to the large-u form and of 1e20.
+        us.extend([1.01, 1.5, 2.0, 9.9e5, 1.01e6, 9.9e19, 1.01e20]);
+        for u in us {
+            let t = u.ln();
+            if (t - 1f64.ln()).abs() < 2.0 * h {
+                continue; // the kink of e'' at yield spoils the difference quotient there
+            }
+            let want = (4.0 * d(t, h / 2.0) - d(t, h)) / 3.0;
+            let (ev, slope) = e_and_slope_ln_u(u);
+            assert_eq!(ev, rebound_u(u).e);
+            assert!((slope - want).abs() < 1e-10, "u {u}: {slope} vs {want}");
+        }
+        assert_eq!(e_and_slope_ln_u(0.5), (1.0, 0.0));
+        assert_eq!(e_and_slope_ln_u(f64::INFINITY).1, 0.0);
+        assert!(e_and_slope_ln_u(f64::NAN).1.is_nan());
+        // Just above yield the slope vanishes like (u - 1): 1 - e ~ (6/25)(u - 1)^2, so
+        // de/d ln u ~ -(12/25)(u - 1) (relative 1e-5 at u - 1 = 1e-6 from the next order).
+        let s = e_and_slope_ln_u(1.0 + 1e-6).1;
+        assert!((s / (-12.0 / 25.0 * 1e-6) - 1.0).abs() < 1e-4, "{s}");
     }
 
     #[test]

@@ -157,6 +157,87 @@ pub fn e_master_in_place(values: &mut [f64], rule: ContactEnd) -> Result<(), usi
     Ok(())
 }
 
+/// [`e_master_in_place`] with the slopes de/d(ln kappa) into `slopes` (same length), for the
+/// fit's Jacobian. On the table, 1 - e = kappa h(s), s = kappa^(1/2), so
+/// d(1 - e)/d ln kappa = kappa (h + s h'(s)/2), with h' from the derivative of Clenshaw's
+/// recurrence (b'_k = 2 b_(k+1) + 2x b'_(k+1) - b'_(k+2)); the interpolant's derivative carries
+/// about DEGREE^2 times the table's error, some 1e-13. Beyond the table: the overlap rule's
+/// A kappa^-5 has slope -5 e exactly; the force rule's large-kappa forms are differenced
+/// centrally in ln kappa (step 2e-5: truncation and rounding each about 1e-11). The e are
+/// bit for bit those of [`e_master_in_place`]; the slopes are checked against central
+/// differences in the test below. The error is as [`e_master_in_place`]'s.
+pub fn e_and_slope_master_in_place(
+    values: &mut [f64],
+    slopes: &mut [f64],
+    rule: ContactEnd,
+) -> Result<(), usize> {
+    assert_eq!(values.len(), slopes.len(), "one slope per value");
+    let (coeffs, large) = match rule {
+        ContactEnd::Overlap => (&table::OVERLAP, KAPPA_OVERLAP_LAW),
+        ContactEnd::Force => (&table::FORCE, KAPPA_FORCE_TABLE),
+    };
+    for (c, (lane_values, lane_slopes)) in values
+        .chunks_mut(LANES)
+        .zip(slopes.chunks_mut(LANES))
+        .enumerate()
+    {
+        let m = lane_values.len();
+        let mut piece = [0usize; LANES];
+        let mut x = [0.0; LANES];
+        let mut s = [0.0; LANES];
+        let mut on_table = [false; LANES];
+        for l in 0..m {
+            let kappa = lane_values[l];
+            if (0.0..large).contains(&kappa) {
+                s[l] = kappa.sqrt();
+                (piece[l], x[l]) = locate(s[l]);
+                on_table[l] = true;
+            }
+        }
+        let (mut b1, mut b2) = ([0.0; LANES], [0.0; LANES]);
+        let (mut d1, mut d2) = ([0.0; LANES], [0.0; LANES]);
+        for j in (1..=table::DEGREE).rev() {
+            for l in 0..LANES {
+                let x2 = 2.0 * x[l];
+                let d0 = 2.0 * b1[l] + x2 * d1[l] - d2[l];
+                let b0 = coeffs[piece[l]][j] + x2 * b1[l] - b2[l];
+                (b2[l], b1[l]) = (b1[l], b0);
+                (d2[l], d1[l]) = (d1[l], d0);
+            }
+        }
+        for l in 0..m {
+            let kappa = lane_values[l];
+            let i = c * LANES + l;
+            (lane_values[l], lane_slopes[l]) = if on_table[l] {
+                let h = coeffs[piece[l]][0] + x[l] * b1[l] - b2[l];
+                // dh/ds = dh/dx dx/ds, dx/ds = 2/PIECE_WIDTH.
+                let dh_ds = (b1[l] + x[l] * d1[l] - d2[l]) * (2.0 / PIECE_WIDTH);
+                (1.0 - kappa * h, -kappa * (h + 0.5 * s[l] * dh_ds))
+            } else {
+                let e = restitution_master(kappa, rule).ok_or(i)?.e;
+                let slope = match rule {
+                    ContactEnd::Overlap => -5.0 * e,
+                    ContactEnd::Force => force_slope_by_differences(kappa, e),
+                };
+                (e, slope)
+            };
+        }
+    }
+    Ok(())
+}
+
+/// de/d ln kappa of the force rule beyond the table by central differences (step 2e-5 in
+/// ln kappa); one-sided where kappa e^(2e-5) overflows (e is 0 to rounding there anyway).
+fn force_slope_by_differences(kappa: f64, e: f64) -> f64 {
+    const H: f64 = 2e-5;
+    let at = |k: f64| restitution_master(k, ContactEnd::Force).map(|r| r.e);
+    match (at(kappa * H.exp()), at(kappa * (-H).exp())) {
+        (Some(up), Some(down)) => (up - down) / (2.0 * H),
+        (None, Some(down)) => (e - down) / H,
+        _ => 0.0,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -197,6 +278,49 @@ mod tests {
                 v[19] = f64::NAN;
                 assert_eq!(e_master_in_place(&mut v, rule), Err(at), "{rule:?} {bad}");
             }
+        }
+    }
+
+    #[test]
+    fn slopes_in_ln_kappa_match_central_differences() {
+        // Against Richardson-extrapolated central differences of restitution_master in
+        // t = ln kappa (h = 1e-3: truncation about h^4 |e^(5)| ~ 1e-12; rounding about
+        // 2.4e-15/h = 2.4e-12, the table's error over the step). Tolerance 1e-10 absolute (e and
+        // its slope are below 1): far above both, far below a wrong term (kappa h is of order
+        // 0.01-1 here). Over 1e-6 .. 1e4, across the hand-over at kappa = 10 (away from it by
+        // more than the step: the forms meet there only to their accuracy), both rules; e bit
+        // for bit as e_master_in_place's.
+        let h = 1e-3;
+        for rule in ContactEnd::ALL {
+            let e = |t: f64| restitution_master(t.exp(), rule).unwrap().e;
+            let d = |t: f64, h: f64| (e(t + h) - e(t - h)) / (2.0 * h);
+            let kappas: Vec<f64> = (0..301)
+                .map(|k| 10f64.powf(-6.0 + k as f64 * 0.0333))
+                .filter(|k| (k.ln() - 10f64.ln()).abs() > 2.0 * h)
+                .chain([0.0])
+                .collect();
+            let mut v = kappas.clone();
+            let mut slopes = vec![0.0; v.len()];
+            e_and_slope_master_in_place(&mut v, &mut slopes, rule).unwrap();
+            let mut plain = kappas.clone();
+            e_master_in_place(&mut plain, rule).unwrap();
+            for (i, &k) in kappas.iter().enumerate() {
+                assert_eq!(v[i].to_bits(), plain[i].to_bits(), "{rule:?} kappa {k}");
+                let want = if k == 0.0 {
+                    0.0
+                } else {
+                    let t = k.ln();
+                    (4.0 * d(t, h / 2.0) - d(t, h)) / 3.0
+                };
+                assert!(
+                    (slopes[i] - want).abs() < 1e-10,
+                    "{rule:?} kappa {k}: {} vs {want}",
+                    slopes[i]
+                );
+            }
+            let mut bad = vec![0.5, f64::NAN, 0.5];
+            let mut s = vec![0.0; 3];
+            assert_eq!(e_and_slope_master_in_place(&mut bad, &mut s, rule), Err(1));
         }
     }
 
