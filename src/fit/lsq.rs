@@ -43,6 +43,20 @@ pub trait Residuals {
     /// Finite-difference step in theta. For central differences the error is about
     /// eps_f / h + h^2 |f'''| / 6, smallest at h ~ eps_f^(1/3), with eps_f the model's accuracy.
     fn fd_step(&self) -> f64;
+    /// The exact Jacobian df_i/dtheta_j at `theta` for the parameters with `free[j]`, in order:
+    /// `out` arrives as zeros of n_residuals x (number of free parameters) and column c gets the
+    /// c-th free parameter's derivatives. `None` (the default) when the problem has no closed
+    /// form: [`jacobian`] then uses central differences. An implementation must agree with
+    /// those to their accuracy (about eps_f^(2/3), see [`Residuals::fd_step`]) and has a
+    /// known-answer test comparing the two; unlike them it is exact on a bound as well.
+    fn jacobian_exact(
+        &self,
+        _theta: &[f64],
+        _free: &[bool],
+        _out: &mut DMatrix<f64>,
+    ) -> Option<Result<()>> {
+        None
+    }
 }
 
 fn nan_residual(theta: &[f64]) -> Error {
@@ -69,9 +83,29 @@ pub fn chi2(p: &impl Residuals, theta: &[f64]) -> Result<f64> {
     Ok(f.iter().map(|x| x * x).sum())
 }
 
-/// The Jacobian df_i/dtheta_j for the parameters with `free[j]`, in order; `f0` are the
+/// The Jacobian df_i/dtheta_j for the parameters with `free[j]`, in order: the problem's exact
+/// one ([`Residuals::jacobian_exact`]) where it has one, else central differences; `f0` are the
 /// residuals at theta (used by one-sided differences at a bound).
 pub fn jacobian(
+    p: &impl Residuals,
+    theta: &[f64],
+    free: &[bool],
+    f0: &[f64],
+) -> Result<DMatrix<f64>> {
+    let n = p.n_residuals();
+    let cols: Vec<usize> = (0..theta.len()).filter(|&j| free[j]).collect();
+    let mut jac = DMatrix::zeros(n, cols.len());
+    if let Some(done) = p.jacobian_exact(theta, free, &mut jac) {
+        done?;
+        return Ok(jac);
+    }
+    jacobian_fd(p, theta, free, f0)
+}
+
+/// The Jacobian by central differences alone (one-sided at a bound), whether or not the problem
+/// has an exact one: what [`jacobian`] falls back to, and the reference an exact Jacobian's
+/// test compares with.
+pub fn jacobian_fd(
     p: &impl Residuals,
     theta: &[f64],
     free: &[bool],

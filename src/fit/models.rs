@@ -412,6 +412,12 @@ impl<'a> Evaluator<'a> {
             .collect();
         results.into_iter().collect()
     }
+
+    /// The power law's per-point logarithms x1 = ln(d/d_ref) and x2 = ln(v/v_ref), in which
+    /// 1 - e = exp(ln A - a x1 + b x2) (for derivatives in closed form).
+    pub fn powerlaw_logs(&self) -> (&[f64], &[f64]) {
+        (&self.powerlaw_ln_d, &self.powerlaw_ln_v)
+    }
 }
 
 #[cfg(test)]
