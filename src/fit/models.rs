@@ -25,6 +25,8 @@ use crate::models::viscoelastic::{self, ContactEnd, VmMethod, master};
 use std::fmt;
 use std::str::FromStr;
 
+mod jacobian;
+
 /// Reference diameter of the power law, mm.
 pub const POWERLAW_D_REF_MM: f64 = 10.0;
 /// Reference speed of the power law, m/s.

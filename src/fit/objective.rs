@@ -97,6 +97,13 @@ impl Residuals for Objective<'_> {
                 self.powerlaw_jacobian(theta, free, out);
                 Some(Ok(()))
             }
+            k if self.ev.has_exact_jacobian(k) => {
+                let p = k.to_physical(theta);
+                Some(
+                    self.ev
+                        .jacobian_separable(k, &p, &self.inv_sigma, free, out),
+                )
+            }
             _ => None,
         }
     }

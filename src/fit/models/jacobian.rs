@@ -1,0 +1,225 @@
+//! The separable models' exact Jacobian (`vm`, `pm`, `min`, `product`) in the fit's internal
+//! coordinates (ln eta, ln sigma_y).
+//!
+//! **Computes** df_i/dtheta_j for f_i = (e_i(model) - e_i)/sigma_i from the slopes of the two
+//! factors ([`master::e_and_slope_master_in_place`], [`plastic::e_and_slope_ln_u`]):
+//! kappa = eta kappa_1 gives d ln kappa/d ln eta = 1, u = v/(V_Y1 sigma_y^(5/2)) gives
+//! d ln u/d ln sigma_y = -5/2. `product`: the product rule; `min`: the derivative of the smaller
+//! factor (at an exact tie, the mean of the two one-sided derivatives, which is what central
+//! differences across the kink give). One pass over the points, where central differences take
+//! two evaluations per free parameter; the master curve only (the ODE has no slope: `--exact`
+//! fits keep central differences).
+//!
+//! **Known answer**: the test below compares it with central differences for every model, both
+//! contact rules and every set of free parameters.
+
+use super::{Evaluator, ModelKind};
+use crate::error::{Error, Result};
+use crate::models::plastic;
+use crate::models::viscoelastic::{VmMethod, master};
+use nalgebra::DMatrix;
+
+impl Evaluator<'_> {
+    /// Whether [`Evaluator::jacobian_separable`] serves `kind` with this evaluator's method.
+    pub fn has_exact_jacobian(&self, kind: ModelKind) -> bool {
+        match kind {
+            ModelKind::Pm => true,
+            ModelKind::Vm | ModelKind::Min | ModelKind::Product => self.method == VmMethod::Master,
+            ModelKind::PowerLaw => false,
+        }
+    }
+
+    /// The weighted residuals' Jacobian of a separable model at physical parameters `p`, for
+    /// the parameters with `free[j]`, into the columns of `out` (n x number of free, in order).
+    /// An error is the first failing point's, as [`Evaluator::predict`]'s.
+    pub fn jacobian_separable(
+        &self,
+        kind: ModelKind,
+        p: &[f64],
+        inv_sigma: &[f64],
+        free: &[bool],
+        out: &mut DMatrix<f64>,
+    ) -> Result<()> {
+        if !self.has_exact_jacobian(kind) {
+            return Err(Error::InvalidParameter {
+                name: "exact Jacobian requested for a model without one (model parameters)",
+                value: p.len() as f64,
+                expected: "vm, min or product with the master curve, or pm",
+            });
+        }
+        let n = self.len();
+        // The factor (0: e_vm, 1: e_pm) each free parameter moves.
+        let axes: Vec<usize> = (0..kind.n_params())
+            .filter(|&j| free[j])
+            .map(|j| if kind == ModelKind::Pm { 1 } else { j })
+            .collect();
+        let (eta, s25) = match kind {
+            ModelKind::Vm => (p[0], f64::NAN),
+            ModelKind::Pm => (f64::NAN, p[0].powf(2.5)),
+            _ => (p[0], p[1].powf(2.5)),
+        };
+        let data = out.as_mut_slice();
+        let (c0, c1) = data.split_at_mut(if axes.len() == 2 { n } else { data.len() });
+        let chunk = |start: usize, c0: &mut [f64], c1: &mut [f64]| -> Result<()> {
+            let m = c0.len();
+            let (mut ev, mut sv) = (vec![1.0; m], vec![0.0; m]);
+            if kind != ModelKind::Pm {
+                for (j, k) in ev.iter_mut().enumerate() {
+                    *k = self.kappa(start + j, eta);
+                }
+                master::e_and_slope_master_in_place(&mut ev, &mut sv, self.rule).map_err(|j| {
+                    self.e_vm(start + j, eta).err().unwrap_or(Error::InvalidParameter {
+                        name: "dimensionless damping kappa (refused by the master curve's slope)",
+                        value: self.kappa(start + j, eta),
+                        expected: "a finite number >= 0",
+                    })
+                })?;
+            }
+            for j in 0..m {
+                let i = start + j;
+                let w = inv_sigma[i];
+                let (ep, sp) = if kind == ModelKind::Vm {
+                    (1.0, 0.0)
+                } else {
+                    let u = self.data.obs[i].v_n_m_s / (self.v_yield_per_pa[i] * s25);
+                    let (e, s) = plastic::e_and_slope_ln_u(u);
+                    (e, -2.5 * s)
+                };
+                let d = match kind {
+                    ModelKind::Min if ev[j] < ep => [sv[j], 0.0],
+                    ModelKind::Min if ep < ev[j] => [0.0, sp],
+                    ModelKind::Min => [0.5 * sv[j], 0.5 * sp],
+                    _ => [ep * sv[j], ev[j] * sp],
+                };
+                c0[j] = d[axes[0]] * w;
+                if let Some(&a) = axes.get(1) {
+                    c1[j] = d[a] * w;
+                }
+            }
+            Ok(())
+        };
+        if axes.is_empty() {
+            return Ok(());
+        }
+        if !super::super::sums::is_large(n) {
+            return chunk(0, c0, c1);
+        }
+        use rayon::prelude::*;
+        let size = super::super::sums::CHUNK;
+        let mut spare = vec![0.0; if c1.is_empty() { n } else { 0 }];
+        let c1 = if c1.is_empty() { &mut spare[..] } else { c1 };
+        let results: Vec<Result<()>> = c0
+            .par_chunks_mut(size)
+            .zip(c1.par_chunks_mut(size))
+            .enumerate()
+            .map(|(c, (a, b))| chunk(c * size, a, b))
+            .collect();
+        results.into_iter().collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::super::dataset::{FitData, Observation};
+    use super::super::super::lsq;
+    use super::super::super::objective::Objective;
+    use super::*;
+    use crate::contact::Material;
+    use crate::models::viscoelastic::ContactEnd;
+
+    /// Exact against central differences (h = the objective's fd_step), on data off every model
+    /// (residuals of both signs), a pair, unequal spheres and a wall, speeds on both sides of
+    /// yield at the parameters tried, for every model, both contact rules and every set of free
+    /// parameters the fits use (all; one held, as in the profiles).
+    #[test]
+    fn separable_exact_jacobian_matches_central_differences() {
+        let m = Material::preset("nylon").unwrap();
+        let mut obs = Vec::new();
+        for (k, (d, d2)) in [
+            (6.35, None),
+            (25.4, Some(12.7)),
+            (12.7, Some(f64::INFINITY)),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            for s in 0..16 {
+                let v = 0.05 * 1.5f64.powi(s);
+                obs.push(Observation {
+                    d_mm: d,
+                    d2_mm: d2,
+                    v_n_m_s: v,
+                    e: 0.9 - 0.02 * s as f64 + 0.01 * ((s as usize + k) as f64).sin(),
+                    e_err: Some(0.005 + 0.001 * s as f64),
+                });
+            }
+        }
+        let data = FitData::new(m, obs).unwrap();
+        let mut checked = 0;
+        for rule in ContactEnd::ALL {
+            let ev = Evaluator::new(&data, rule, VmMethod::Master);
+            for kind in [
+                ModelKind::Vm,
+                ModelKind::Pm,
+                ModelKind::Min,
+                ModelKind::Product,
+            ] {
+                let obj = Objective::new(&ev, kind).unwrap();
+                let k = kind.n_params();
+                let mid: Vec<f64> = (0..k)
+                    .map(|j| 0.5 * (obj.lower[j] + obj.upper[j]))
+                    .collect();
+                let near_lo: Vec<f64> = (0..k)
+                    .map(|j| 0.8 * obj.lower[j] + 0.2 * obj.upper[j])
+                    .collect();
+                let frees: Vec<Vec<bool>> = if k == 1 {
+                    vec![vec![true]]
+                } else {
+                    vec![vec![true, true], vec![false, true], vec![true, false]]
+                };
+                for theta in [mid, near_lo] {
+                    let mut f0 = vec![0.0; ev.len()];
+                    lsq::residuals_checked(&obj, &theta, &mut f0).unwrap();
+                    let p = kind.to_physical(&theta);
+                    for free in &frees {
+                        let exact = lsq::jacobian(&obj, &theta, free, &f0).unwrap();
+                        let fd = lsq::jacobian_fd(&obj, &theta, free, &f0).unwrap();
+                        assert_eq!(exact.shape(), fd.shape());
+                        for c in 0..exact.ncols() {
+                            let scale = fd.column(c).amax().max(1e-300);
+                            for i in 0..ev.len() {
+                                let diff = (exact[(i, c)] - fd[(i, c)]).abs();
+                                // Central differences err by h^2 |f'''|/6 (h = fd_step = 1e-5:
+                                // about 1e-11 of the column's scale) plus the rounding of the
+                                // difference of two values of f_i = (e - e_i) w_i, at most
+                                // 2 e_accuracy w_i/(2h) (e near 1 keeps only 1e-16 of 1 - e:
+                                // at small kappa this term is the larger, some 1e-6 relative).
+                                // Allowed: 1e-7 of the column's largest entry plus that
+                                // rounding term; a wrong factor (5/2, a product-rule term)
+                                // errs by 1e-1 of the entry or more. `min` at a point within h
+                                // of its kink differs by half the jump there: such points (the
+                                // two factors within 1e-4) are skipped.
+                                let tol =
+                                    1e-7 * scale + obj.e_accuracy * obj.inv_sigma[i] / obj.fd_step;
+                                let err = diff / scale;
+                                let near_kink = kind == ModelKind::Min && {
+                                    let a = ev.e_vm(i, p[0]).unwrap();
+                                    (a - ev.e_pm(i, p[1])).abs() < 1e-4
+                                };
+                                assert!(
+                                    near_kink || diff <= tol,
+                                    "{rule:?} {kind} theta {theta:?} free {free:?} point {i} \
+                                     column {c}: {} vs {} ({err:e})",
+                                    exact[(i, c)],
+                                    fd[(i, c)]
+                                );
+                                checked += usize::from(!near_kink);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert!(checked > 1000, "{checked}");
+    }
+}
