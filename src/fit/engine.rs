@@ -17,7 +17,8 @@
 //!   cannot exclude the parameter ceasing to matter, so a value with an error bar would mislead.
 //!
 //! Nothing is lost silently: a search that could not be certified, a polish that did not
-//! converge, a profile that found a lower minimum (the fit refits from it, three times at most),
+//! converge, a profile that found a lower minimum (the fit refits from it, three times at most,
+//! with Levenberg-Marquardt finished by damped Newton where it runs out of iterations),
 //! an interval end not found, or a second region inside the 95% threshold that the interval
 //! does not cover: each is a line in the result's `warnings`, and `converged` is false whenever
 //! the reported minimum itself is in doubt.
@@ -29,7 +30,7 @@ use super::dataset::FitData;
 use super::lsq::{self, LmOptions};
 use super::models::{Evaluator, ModelKind};
 use super::objective::{Objective, check_size};
-use super::polish::Found;
+use super::polish::{Found, polish_newton};
 use super::profile::{ProfileOutcome, Profiles, Side, profile_intervals};
 use super::result::{FitResult, show};
 use super::search::{SearchOutcome, global_minimum};
@@ -129,13 +130,19 @@ pub fn fit(data: &FitData, kind: ModelKind, options: &FitOptions) -> Result<FitR
                         show(again.chi2 + obj.chi2_offset),
                         show(best.chi2 + obj.chi2_offset)
                     ));
+                    let mut again = Found {
+                        theta: again.theta,
+                        chi2: again.chi2,
+                        converged: again.converged,
+                        reason: again.reason.to_string(),
+                    };
+                    if !again.converged {
+                        // Levenberg-Marquardt creeping along a narrow curved valley (where a
+                        // point starts to yield) hands over to Newton, as in the search.
+                        again = polish_newton(&obj, again)?;
+                    }
                     if again.chi2 < best.chi2 {
-                        best = Found {
-                            theta: again.theta,
-                            chi2: again.chi2,
-                            converged: again.converged,
-                            reason: again.reason.to_string(),
-                        };
+                        best = again;
                         converged = converged && best.converged;
                     }
                 }
