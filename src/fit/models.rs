@@ -349,6 +349,15 @@ impl<'a> Evaluator<'a> {
     pub fn powerlaw_logs(&self) -> (&[f64], &[f64]) {
         (&self.powerlaw_ln_d, &self.powerlaw_ln_v)
     }
+
+    /// The power law's e at every point for ln A (not A: the caller forms it once, where
+    /// [`Evaluator::predict`] takes a log per point) and exponents a, b, into `out`; the same
+    /// values as `predict` given A = exp(ln A) when ln A is the log of that A as computed
+    /// (in parallel for large data, each value computed alone).
+    pub fn predict_powerlaw(&self, ln_a: f64, a: f64, b: f64, out: &mut [f64]) {
+        let n = self.len().min(out.len());
+        super::sums::fill(&mut out[..n], |i| self.e_powerlaw(i, ln_a, a, b));
+    }
 }
 
 #[cfg(test)]

@@ -66,8 +66,15 @@ impl Residuals for Objective<'_> {
     }
     fn residuals(&self, theta: &[f64], out: &mut [f64]) -> Result<()> {
         self.evals.set(self.evals.get() + 1);
-        let p = self.kind.to_physical(theta);
-        self.ev.predict(self.kind, &p, out)?;
+        if self.kind == ModelKind::PowerLaw {
+            // ln A as `predict` forms it from A = exp(theta_0) (the same residuals to the last
+            // bit), once per call instead of once per point.
+            let ln_a = theta[0].exp().ln();
+            self.ev.predict_powerlaw(ln_a, theta[1], theta[2], out);
+        } else {
+            let p = self.kind.to_physical(theta);
+            self.ev.predict(self.kind, &p, out)?;
+        }
         for (i, o) in out.iter_mut().enumerate() {
             *o = (*o - self.ev.data.obs[i].e) * self.inv_sigma[i];
         }
