@@ -43,6 +43,8 @@ pub struct Objective<'a> {
     pub fd_step: f64,
     pub evals: Cell<u64>,
     pub inv_sigma: Vec<f64>,
+    /// The measured e of each point (contiguous, for the residuals' loop).
+    e_obs: Vec<f64>,
     /// Bound on the error of one evaluation of e (see [`model_accuracy`]).
     pub e_accuracy: f64,
     /// Things the set-up changed and a user should know (a narrowed box).
@@ -75,8 +77,8 @@ impl Residuals for Objective<'_> {
             let p = self.kind.to_physical(theta);
             self.ev.predict(self.kind, &p, out)?;
         }
-        for (i, o) in out.iter_mut().enumerate() {
-            *o = (*o - self.ev.data.obs[i].e) * self.inv_sigma[i];
+        for ((o, e), s) in out.iter_mut().zip(&self.e_obs).zip(&self.inv_sigma) {
+            *o = (*o - e) * s;
         }
         Ok(())
     }
@@ -127,6 +129,7 @@ impl<'a> Objective<'a> {
             fd_step: fd_step_for(kind, &ev.method),
             evals: Cell::new(0),
             inv_sigma,
+            e_obs: data.obs.iter().map(|o| o.e).collect(),
             e_accuracy: model_accuracy(&ev.method),
             warnings,
             rows: data.len(),
