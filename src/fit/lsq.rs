@@ -233,7 +233,8 @@ pub fn levenberg_marquardt(
     let mut nu = 2.0;
     let mut f_new = vec![0.0; n];
     let mut need_jac = true;
-    let mut jac = DMatrix::zeros(0, 0);
+    // J^T J over the parameters free for the step (computed once per Jacobian).
+    let mut a = DMatrix::zeros(0, 0);
     let mut free_now: Vec<bool> = free.to_vec();
     let mut g_full = vec![0.0; theta.len()];
     for it in 1..=opts.max_iterations {
@@ -244,7 +245,7 @@ pub fn levenberg_marquardt(
                 return Ok(outcome(theta, chi2v, it, false, "Jacobian not finite"));
             }
             let fv = DVector::from_column_slice(&f);
-            let g_all = all.transpose() * &fv;
+            let g_all = all.tr_mul(&fv);
             let cols: Vec<usize> = (0..theta.len()).filter(|&j| free[j]).collect();
             let fnorm = fv.norm();
             let mut worst: f64 = 0.0;
@@ -276,12 +277,11 @@ pub fn levenberg_marquardt(
                 .filter(|(_, j)| free_now[**j])
                 .map(|(c, _)| c)
                 .collect();
-            jac = all.select_columns(&keep);
+            a = all.tr_mul(&all).select_rows(&keep).select_columns(&keep);
             need_jac = false;
         }
         let idx: Vec<usize> = (0..theta.len()).filter(|&j| free_now[j]).collect();
         let m = idx.len();
-        let a = jac.transpose() * &jac;
         let g = DVector::from_iterator(m, idx.iter().map(|&j| g_full[j]));
         let dmax = (0..m).map(|k| a[(k, k)]).fold(0.0, f64::max);
         let mut lhs = a.clone();

@@ -307,49 +307,70 @@ impl PowerLaw {
         let (zb0, zb1) = (self.row(1, lo[1]), self.row(1, hi[1]));
         let (c1, c2, w) = (&self.c1[..], &self.c2[..], &self.w[..]);
         let e_max = h.map_or(0.0, |h| self.m_max(h).exp() * (1.0 + 1e-15));
-        let point = |i: usize, o: [&mut f64; 4]| -> f64 {
-            let (amin, amax) = (za0[i].min(za1[i]), za0[i].max(za1[i]));
-            let (bmin, bmax) = (zb0[i].min(zb1[i]), zb0[i].max(zb1[i]));
-            let zhi = amax * bmax * (1.0 + Z_SLACK);
-            *o[0] = amin * bmin * (1.0 - Z_SLACK);
-            *o[1] = zhi;
+        // The points start..start + len into the chunk's slices: straight loops over slices
+        // without branches, which vectorise; a centre whose corners' product overflows or
+        // underflows (rare) is redone after, and the sum is taken in point order last (so the
+        // values are those of a loop point by point, to the last bit).
+        let chunk = |start: usize, o: [&mut [f64]; 4]| -> f64 {
+            let [o0, o1, o2, o3] = o;
+            let len = o0.len();
+            let r = start..start + len;
+            let (za0, za1) = (&za0[r.clone()], &za1[r.clone()]);
+            let (zb0, zb1) = (&zb0[r.clone()], &zb1[r.clone()]);
+            let (o1, o2, o3) = (&mut o1[..len], &mut o2[..len], &mut o3[..len]);
+            for j in 0..len {
+                let (amin, amax) = (za0[j].min(za1[j]), za0[j].max(za1[j]));
+                let (bmin, bmax) = (zb0[j].min(zb1[j]), zb0[j].max(zb1[j]));
+                o0[j] = amin * bmin * (1.0 - Z_SLACK);
+                o1[j] = amax * bmax * (1.0 + Z_SLACK);
+            }
             let Some([ha, hb]) = h else {
                 return 0.0;
             };
+            let (c1, c2, w) = (&c1[r.clone()], &c2[r.clone()], &w[r]);
+            let remainder = |j: usize, zc: f64| {
+                let m = c1[j].abs() * ha + c2[j].abs() * hb;
+                zc * linearized::remainder_bound(m, e_max)
+            };
             // exp(-a_c c1 + b_c c2) = sqrt of the product of the corners' rows, which can
             // overflow where the rows do not: then a square root each.
-            let mut zc = (za0[i] * za1[i] * (zb0[i] * zb1[i])).sqrt();
-            if !(zc.is_finite() && zc > 0.0) {
-                zc = (amin.sqrt() * amax.sqrt()) * (bmin.sqrt() * bmax.sqrt());
+            let mut redo = false;
+            for j in 0..len {
+                let zc = (za0[j] * za1[j] * (zb0[j] * zb1[j])).sqrt();
+                redo |= !(zc.is_finite() && zc > 0.0);
+                o2[j] = zc;
+                o3[j] = remainder(j, zc);
             }
-            let m = c1[i].abs() * ha + c2[i].abs() * hb;
-            *o[2] = zc;
-            *o[3] = zc * linearized::remainder_bound(m, e_max);
-            w[i] * zhi * zhi
-        };
-        let [o0, o1, o2, o3] = out;
-        if !sums::is_large(self.n) {
+            if redo {
+                for j in 0..len {
+                    if !(o2[j].is_finite() && o2[j] > 0.0) {
+                        let (amin, amax) = (za0[j].min(za1[j]), za0[j].max(za1[j]));
+                        let (bmin, bmax) = (zb0[j].min(zb1[j]), zb0[j].max(zb1[j]));
+                        let zc = (amin.sqrt() * amax.sqrt()) * (bmin.sqrt() * bmax.sqrt());
+                        o2[j] = zc;
+                        o3[j] = remainder(j, zc);
+                    }
+                }
+            }
             let mut s = 0.0;
-            for i in 0..self.n {
-                s += point(i, [&mut o0[i], &mut o1[i], &mut o2[i], &mut o3[i]]);
+            for j in 0..len {
+                s += w[j] * o1[j] * o1[j];
             }
-            return s;
+            s
+        };
+        let n = self.n;
+        let [o0, o1, o2, o3] = out;
+        if !sums::is_large(n) {
+            return chunk(0, [&mut o0[..n], &mut o1[..n], &mut o2[..n], &mut o3[..n]]);
         }
         // Chunks in parallel, their sums added in chunk order (as in [`sums::sum`]).
-        let parts: Vec<f64> = o0
+        let parts: Vec<f64> = o0[..n]
             .par_chunks_mut(sums::CHUNK)
-            .zip(o1.par_chunks_mut(sums::CHUNK))
-            .zip(o2.par_chunks_mut(sums::CHUNK))
-            .zip(o3.par_chunks_mut(sums::CHUNK))
+            .zip(o1[..n].par_chunks_mut(sums::CHUNK))
+            .zip(o2[..n].par_chunks_mut(sums::CHUNK))
+            .zip(o3[..n].par_chunks_mut(sums::CHUNK))
             .enumerate()
-            .map(|(c, (((p0, p1), p2), p3))| {
-                let mut s = 0.0;
-                for j in 0..p0.len() {
-                    let o = [&mut p0[j], &mut p1[j], &mut p2[j], &mut p3[j]];
-                    s += point(c * sums::CHUNK + j, o);
-                }
-                s
-            })
+            .map(|(c, (((p0, p1), p2), p3))| chunk(c * sums::CHUNK, [p0, p1, p2, p3]))
             .collect();
         parts.iter().sum()
     }
