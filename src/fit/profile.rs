@@ -99,12 +99,8 @@ pub fn profile_intervals_of(
             let warm = RefCell::new(vec![(theta[j], theta.to_vec())]);
             let lower_found = RefCell::new(None::<Vec<f64>>);
             let profile = |t: f64| -> Result<f64> {
-                let mut start = warm
-                    .borrow()
-                    .iter()
-                    .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
-                    .map(|(_, th)| th.clone())
-                    .unwrap_or_else(|| theta.to_vec());
+                let mut start =
+                    warm_start(&warm.borrow(), t, lower, upper).unwrap_or_else(|| theta.to_vec());
                 start[j] = t;
                 let (c, th) = if k == 1 {
                     (lsq::chi2(obj, &start)?, start)
@@ -144,6 +140,32 @@ pub fn profile_intervals_of(
     }))
 }
 
+/// The start of the inner minimisation at t: the other parameters on the line through the two
+/// profile points already computed nearest to t (the valley's direction, so the start is off
+/// it only by the valley's curvature), kept in the box; the nearest point's when there is one
+/// (or the two share their t).
+fn warm_start(warm: &[(f64, Vec<f64>)], t: f64, lower: &[f64], upper: &[f64]) -> Option<Vec<f64>> {
+    let by_distance =
+        |a: &&(f64, Vec<f64>), b: &&(f64, Vec<f64>)| (a.0 - t).abs().total_cmp(&(b.0 - t).abs());
+    let (t1, th1) = warm.iter().min_by(by_distance)?;
+    let Some((t2, th2)) = warm.iter().filter(|p| p.0 != *t1).min_by(by_distance) else {
+        return Some(th1.clone());
+    };
+    let s = (t - t1) / (t2 - t1);
+    Some(
+        (0..th1.len())
+            .map(|k| {
+                let x = th1[k] + s * (th2[k] - th1[k]);
+                if x.is_finite() {
+                    x.max(lower[k]).min(upper[k])
+                } else {
+                    th1[k]
+                }
+            })
+            .collect(),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -178,6 +200,26 @@ mod tests {
         fn fd_step(&self) -> f64 {
             1e-5
         }
+    }
+
+    #[test]
+    fn warm_starts_follow_the_line_through_the_two_nearest_points() {
+        let (lo, hi) = ([-10.0, -10.0], [10.0, 10.0]);
+        // Points of the valley x1 = 2 t + 1 (and a far one that must not be used).
+        let warm = vec![
+            (0.0, vec![0.0, 1.0]),
+            (1.0, vec![1.0, 3.0]),
+            (-5.0, vec![-5.0, 100.0]),
+        ];
+        // Between and beyond the two nearest: on their line, exactly (binary fractions).
+        assert_eq!(warm_start(&warm, 0.5, &lo, &hi), Some(vec![0.5, 2.0]));
+        assert_eq!(warm_start(&warm, 2.0, &lo, &hi), Some(vec![2.0, 5.0]));
+        // Kept in the box; one point (or two at the same t) is a start as it is.
+        assert_eq!(warm_start(&warm, 6.0, &lo, &hi), Some(vec![6.0, 10.0]));
+        assert_eq!(warm_start(&warm[..1], 3.0, &lo, &hi), Some(vec![0.0, 1.0]));
+        let twice = vec![(1.0, vec![1.0, 3.0]), (1.0, vec![1.0, 4.0])];
+        assert_eq!(warm_start(&twice, 2.0, &lo, &hi), Some(vec![1.0, 3.0]));
+        assert_eq!(warm_start(&[], 2.0, &lo, &hi), None);
     }
 
     #[test]
