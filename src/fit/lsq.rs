@@ -13,7 +13,8 @@
 //!   parameter that stops mattering gives a singular J^T J, which the damping handles); and with
 //!   at most 3 parameters the whole method is a dense 3 x 3 solve per step. It is a local
 //!   method: the global search ([`super::search`]) decides where it starts.
-//! - [`jacobian`]: central differences with a step matched to the accuracy of the model (see
+//! - [`jacobian`]: the problem's exact Jacobian where it has one ([`Residuals::jacobian_exact`]),
+//!   else central differences with a step matched to the accuracy of the model (see
 //!   [`Residuals::fd_step`]); one-sided at a bound.
 //! - [`covariance`] (in [`super::covariance`]): (J^T J)^-1, the covariance of theta when the
 //!   sigma_i are exact.
