@@ -5,7 +5,8 @@
 # them; above 16384 points its sums run on both cores, so wall time depends on the machine's
 # load). Quoted in the README (fuzzing; known limitations). With the first-order cell bounds
 # alone the distinct-speed fits took 2.3 (vm) to 33 s (powerlaw) of CPU; with the second-order
-# bounds (docs/physics.md §7.4) 0.4-5.2 s.
+# bounds (docs/physics.md §7.4) 0.4-5.9 s; with exact Jacobians (§7.5), warm-started profiles
+# and e_vm eight points at a time 0.6-3.6 s.
 #
 # Usage: bash scripts/time_big_fit.sh [BINARY]   (default target/release/restitution)
 set -euo pipefail
