@@ -27,10 +27,10 @@ mod summary;
 
 use super::compare::{Comparison, compare};
 use super::dataset::FitData;
-use super::lsq::{self, LmOptions};
+use super::lsq;
 use super::models::{Evaluator, ModelKind};
 use super::objective::{Objective, check_size};
-use super::polish::{Found, polish_newton};
+use super::polish::{polish_lm, polish_newton};
 use super::profile::{ProfileOutcome, Profiles, Side, profile_intervals};
 use super::result::{FitResult, show};
 use super::search::{SearchOutcome, global_minimum};
@@ -123,19 +123,12 @@ pub fn fit(data: &FitData, kind: ModelKind, options: &FitOptions) -> Result<FitR
                 }
                 ProfileOutcome::Lower(t) if refits < MAX_REFITS => {
                     refits += 1;
-                    let all = vec![true; k];
-                    let again = lsq::levenberg_marquardt(&obj, &t, &all, &LmOptions::default())?;
+                    let mut again = polish_lm(&obj, &t)?;
                     warnings.push(format!(
                         "a profile found chi2 {} below the minimum {}; refitted from it",
                         show(again.chi2 + obj.chi2_offset),
                         show(best.chi2 + obj.chi2_offset)
                     ));
-                    let mut again = Found {
-                        theta: again.theta,
-                        chi2: again.chi2,
-                        converged: again.converged,
-                        reason: again.reason.to_string(),
-                    };
                     if !again.converged {
                         // Levenberg-Marquardt creeping along a narrow curved valley (where a
                         // point starts to yield) hands over to Newton, as in the search.

@@ -321,19 +321,21 @@ impl<'a> Evaluator<'a> {
         for (j, slot) in out.iter_mut().enumerate() {
             *slot = self.kappa(start + j, eta);
         }
-        master::e_master_in_place(out, self.rule).map_err(|j| {
-            // The point's own error (the master curve refuses only what `e_vm` refuses; the
-            // second arm is for that promise broken, never a silent success).
-            let i = start + j;
-            match self.e_vm(i, eta) {
-                Err(e) => e,
-                Ok(_) => Error::InvalidParameter {
-                    name: "dimensionless damping kappa (refused by the interleaved master curve)",
-                    value: self.kappa(i, eta),
-                    expected: "a finite number >= 0",
-                },
-            }
-        })
+        master::e_master_in_place(out, self.rule).map_err(|j| self.master_refusal(start + j, eta))
+    }
+
+    /// The error for point `i`, whose kappa the interleaved master curve refused: `e_vm`'s own
+    /// (the curve refuses only what `e_vm` refuses; the second arm is for that promise broken,
+    /// never a silent success).
+    fn master_refusal(&self, i: usize, eta: f64) -> Error {
+        match self.e_vm(i, eta) {
+            Err(e) => e,
+            Ok(_) => Error::InvalidParameter {
+                name: "dimensionless damping kappa (refused by the interleaved master curve)",
+                value: self.kappa(i, eta),
+                expected: "a finite number >= 0",
+            },
+        }
     }
 
     /// e_vm of every point at damping eta, into `out`; NaN where the model cannot be evaluated

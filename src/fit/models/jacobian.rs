@@ -67,13 +67,8 @@ impl Evaluator<'_> {
                 for (j, k) in ev.iter_mut().enumerate() {
                     *k = self.kappa(start + j, eta);
                 }
-                master::e_and_slope_master_in_place(&mut ev, &mut sv, self.rule).map_err(|j| {
-                    self.e_vm(start + j, eta).err().unwrap_or(Error::InvalidParameter {
-                        name: "dimensionless damping kappa (refused by the master curve's slope)",
-                        value: self.kappa(start + j, eta),
-                        expected: "a finite number >= 0",
-                    })
-                })?;
+                master::e_and_slope_master_in_place(&mut ev, &mut sv, self.rule)
+                    .map_err(|j| self.master_refusal(start + j, eta))?;
             }
             for j in 0..m {
                 let i = start + j;
@@ -106,14 +101,18 @@ impl Evaluator<'_> {
         }
         use rayon::prelude::*;
         let size = super::super::sums::CHUNK;
-        let mut spare = vec![0.0; if c1.is_empty() { n } else { 0 }];
-        let c1 = if c1.is_empty() { &mut spare[..] } else { c1 };
-        let results: Vec<Result<()>> = c0
-            .par_chunks_mut(size)
-            .zip(c1.par_chunks_mut(size))
-            .enumerate()
-            .map(|(c, (a, b))| chunk(c * size, a, b))
-            .collect();
+        let results: Vec<Result<()>> = if c1.is_empty() {
+            c0.par_chunks_mut(size)
+                .enumerate()
+                .map(|(c, a)| chunk(c * size, a, &mut []))
+                .collect()
+        } else {
+            c0.par_chunks_mut(size)
+                .zip(c1.par_chunks_mut(size))
+                .enumerate()
+                .map(|(c, (a, b))| chunk(c * size, a, b))
+                .collect()
+        };
         results.into_iter().collect()
     }
 }

@@ -228,14 +228,16 @@ pub fn e_and_slope_master_in_place(
 }
 
 /// de/d ln kappa of the force rule beyond the table by central differences (step 2e-5 in
-/// ln kappa); one-sided where kappa e^(2e-5) overflows (e is 0 to rounding there anyway).
+/// ln kappa); one-sided where kappa e^(2e-5) overflows (e is 0 to rounding there anyway). NaN
+/// if the lower point were refused (it cannot be for a kappa the curve accepted): a Jacobian
+/// that is not finite ends Levenberg-Marquardt unconverged, never a made-up slope.
 fn force_slope_by_differences(kappa: f64, e: f64) -> f64 {
     const H: f64 = 2e-5;
     let at = |k: f64| restitution_master(k, ContactEnd::Force).map(|r| r.e);
     match (at(kappa * H.exp()), at(kappa * (-H).exp())) {
         (Some(up), Some(down)) => (up - down) / (2.0 * H),
         (None, Some(down)) => (e - down) / H,
-        _ => 0.0,
+        (_, None) => f64::NAN,
     }
 }
 
