@@ -71,46 +71,10 @@ pub struct PlasticRebound {
 /// [`U_ASYMPTOTE`] on). Right for every finite u >= 0; +inf gives the limit e = 0; NaN gives NaN
 /// (use [`try_rebound_u`] for unvalidated input).
 pub fn rebound_u(u: f64) -> PlasticRebound {
-    if u.is_nan() {
-        return PlasticRebound {
-            e: f64::NAN,
-            one_minus_e: f64::NAN,
-        };
-    }
-    if u <= 1.0 {
-        return PlasticRebound {
-            e: 1.0,
-            one_minus_e: 0.0,
-        };
-    }
-    if u >= U_ASYMPTOTE {
-        // Above 1e20 the correction (< 1.2e-21) is below rounding; skipping it also keeps 1/u out
-        // of the subnormal range near f64::MAX, where it cost 200 ns instead of 6.
-        let corr = if u < 1e20 {
-            let t = 1.0 / u;
-            1.0 + t * (A1 + t * (A2 + t * A3))
-        } else {
-            1.0
-        };
-        // u^(-1/4) through two correctly rounded square roots (no overflow up to f64::MAX, and
-        // e = 0 only for u = +inf).
-        let e = C_ASYMPTOTE * (corr / u.sqrt().sqrt());
-        return PlasticRebound {
-            e,
-            one_minus_e: 1.0 - e,
-        };
-    }
-    let w = (30.0 * u).mul_add(u, -5.0).sqrt();
-    // q = (2/15)(w - 5), with w - 5 = 30 (u - 1)(u + 1)/(w + 5): no cancellation as u -> 1.
-    let q = 4.0 * (u - 1.0) * (u + 1.0) / (w + 5.0);
-    // Two correctly rounded square roots: as accurate as powf(0.25) here (1.2 ulp in e over the
-    // fixture) and three times faster.
-    let e = (1.0 + 1.5 * q) / (u * (1.0 + q).sqrt().sqrt());
-    // Just above yield the exact e is 1 - O((u - 1)^2), whose nearest double is 1, and the last
-    // rounding can lift the quotient to 1 + 2e-16 (seen at u = 1 + 1e-12): that is rounding, and
-    // e is finite here (u in (1, 1e6)), so taking 1 hides nothing.
-    let e = if e > 1.0 { 1.0 } else { e };
-    let one_minus_e = if e > 0.5 {
+    let (e, w) = e_and_w(u);
+    // Below yield, for NaN and from the asymptote on (w is NaN there) 1 - e has no cancellation
+    // to avoid: e is 1, NaN, or below 0.5.
+    let one_minus_e = if e > 0.5 && !w.is_nan() {
         // 1 - e^4 = 900 ((u-1)(u+1))^2 Q(w) / ((w+5)^2 (w^2+5)^2 (2w+5)), Q = 2w^3 + 3.4w^2 + 4w + 5,
         // then 1 - e = (1 - e^4)/((1 + e)(1 + e^2)). Measured <= 4.4 ulp against mpmath over
         // 161 points from u = 1 + 1e-12 to 1e12 (with w - 5 formed separately it reached 5.2 ulp).
@@ -123,6 +87,47 @@ pub fn rebound_u(u: f64) -> PlasticRebound {
         1.0 - e
     };
     PlasticRebound { e, one_minus_e }
+}
+
+/// e of [`rebound_u`] alone (the same double): the fit needs e at every point on every
+/// evaluation, and 1 - e's cancellation-free form costs as much again.
+#[inline]
+pub fn rebound_e(u: f64) -> f64 {
+    e_and_w(u).0
+}
+
+/// e(u) and, between yield and [`U_ASYMPTOTE`], w = sqrt(30 u^2 - 5) (NaN elsewhere).
+#[inline(always)]
+fn e_and_w(u: f64) -> (f64, f64) {
+    if u.is_nan() {
+        return (f64::NAN, f64::NAN);
+    }
+    if u <= 1.0 {
+        return (1.0, f64::NAN);
+    }
+    if u >= U_ASYMPTOTE {
+        // Above 1e20 the correction (< 1.2e-21) is below rounding; skipping it also keeps 1/u out
+        // of the subnormal range near f64::MAX, where it cost 200 ns instead of 6.
+        let corr = if u < 1e20 {
+            let t = 1.0 / u;
+            1.0 + t * (A1 + t * (A2 + t * A3))
+        } else {
+            1.0
+        };
+        // u^(-1/4) through two correctly rounded square roots (no overflow up to f64::MAX, and
+        // e = 0 only for u = +inf).
+        return (C_ASYMPTOTE * (corr / u.sqrt().sqrt()), f64::NAN);
+    }
+    let w = (30.0 * u).mul_add(u, -5.0).sqrt();
+    // q = (2/15)(w - 5), with w - 5 = 30 (u - 1)(u + 1)/(w + 5): no cancellation as u -> 1.
+    let q = 4.0 * (u - 1.0) * (u + 1.0) / (w + 5.0);
+    // Two correctly rounded square roots: as accurate as powf(0.25) here (1.2 ulp in e over the
+    // fixture) and three times faster.
+    let e = (1.0 + 1.5 * q) / (u * (1.0 + q).sqrt().sqrt());
+    // Just above yield the exact e is 1 - O((u - 1)^2), whose nearest double is 1, and the last
+    // rounding can lift the quotient to 1 + 2e-16 (seen at u = 1 + 1e-12): that is rounding, and
+    // e is finite here (u in (1, 1e6)), so taking 1 hides nothing.
+    (if e > 1.0 { 1.0 } else { e }, w)
 }
 
 /// e(u) of [`rebound_u`] and its slope de/d(ln u), for the fit's Jacobian (exact derivatives
@@ -266,6 +271,28 @@ impl Plastic {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn e_alone_is_the_full_evaluations_e() {
+        // The fit's e-only path must not drift from the checked one: the same double at the
+        // special values, around yield and the asymptote's hand-over, and on a sweep.
+        let mut us = vec![
+            f64::NAN,
+            0.0,
+            1.0,
+            1.0 + 1e-12,
+            U_ASYMPTOTE,
+            U_ASYMPTOTE * (1.0 - 1e-16),
+            1e20,
+            f64::MAX,
+            f64::INFINITY,
+        ];
+        us.extend((0..2000).map(|k| 10f64.powf(-2.0 + 14.0 * k as f64 / 1999.0)));
+        for u in us {
+            let (a, b) = (rebound_e(u), rebound_u(u).e);
+            assert!(a.to_bits() == b.to_bits(), "u {u}: {a} against {b}");
+        }
+    }
 
     #[test]
     fn curvature_in_ln_u_stays_below_its_bound_with_its_margin() {
