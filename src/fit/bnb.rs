@@ -431,6 +431,36 @@ impl<L: Landscape> Bnb<L> {
         Split::Cells(out)
     }
 
+    /// Whether the point at internal coordinates `t` may have chi2 below `target` as far as the
+    /// bounds know: it lies in a cell left at the resolution, unresolved or still queued whose
+    /// bound is below `target`. Every other cell of the box was dropped or set aside with a
+    /// bound at or above U - tau for a U at least the current one, and U - tau grows with U, so
+    /// for `target` <= U - tau a false answer is a proof (cells are closed: a point on a shared
+    /// edge belongs to both; a relative slack of 1e-12 of the box covers the rounding of the
+    /// corners' coordinates).
+    pub fn may_hold_below(&self, t: [f64; 2], target: f64) -> bool {
+        let inside = |c: &Cell| {
+            (0..2).all(|k| {
+                let a = &self.axes[k];
+                if !a.active {
+                    return true;
+                }
+                let slack = 1e-12 * (a.hi - a.lo).abs();
+                a.t_at(c.p0[k]) - slack <= t[k] && t[k] <= a.t_at(c.p1[k]) + slack
+            })
+        };
+        // Before the first refinement nothing is proved; NaN coordinates are outside every cell,
+        // and nothing is known of them.
+        if !self.started || t.iter().any(|x| x.is_nan()) {
+            return true;
+        }
+        self.fine
+            .iter()
+            .chain(self.unresolved.iter().map(|(c, _)| c))
+            .chain(self.heap.iter().map(|b| &b.0))
+            .any(|c| !(c.bound.lb >= target) && inside(c))
+    }
+
     /// The certificate for `upper` (see [`Certificate`]).
     pub fn certificate(&self, upper: f64) -> Certificate {
         let lowest = |it: &mut dyn Iterator<Item = &Cell>| {

@@ -246,7 +246,7 @@ mod tests {
         let truth = ModelKind::Min.to_internal(&p);
         let start = [truth[0] + 0.3, truth[1] - 0.05];
         let f = polish_lm(&obj, &start).unwrap();
-        let f = polish_valleys(&obj, f).unwrap();
+        let f = polish_valleys(&obj, f, &|_| true).unwrap();
         let f = polish_profiles(&obj, f).unwrap();
         let close = f
             .theta

@@ -71,7 +71,16 @@ pub fn polish_brent(obj: &Objective, t: f64, lo: f64, hi: f64, at_node: f64) -> 
 /// repeated while it gains. Levenberg-Marquardt can stop on a kink of `min` (its Gauss-Newton
 /// model sees one branch) or in a long flat valley with shallow wiggles; a derivative-free line
 /// search along the valley does not.
-pub fn polish_valleys(obj: &Objective, start: Found) -> Result<Found> {
+///
+/// `may_beat(theta)`: false where the global search has proved chi2 no lower than its
+/// tolerance below the best minimum known ([`super::bnb::Bnb::may_hold_below`]); the scan's
+/// grid points there are not evaluated (nothing they could show would change the answer by more
+/// than the tolerance). `|_| true` scans every point.
+pub fn polish_valleys(
+    obj: &Objective,
+    start: Found,
+    may_beat: &dyn Fn(&[f64]) -> bool,
+) -> Result<Found> {
     let k = start.theta.len();
     let mut best = start;
     for _ in 0..VALLEY_ROUNDS {
@@ -101,7 +110,15 @@ pub fn polish_valleys(obj: &Objective, start: Found) -> Result<Found> {
                 .collect();
             let vals = grid
                 .iter()
-                .map(|&a| lsq::chi2(obj, &at(a)))
+                .map(|&a| {
+                    let t = at(a);
+                    // A point the bounds exclude is left out as NaN is (never the best).
+                    if may_beat(&t) {
+                        lsq::chi2(obj, &t)
+                    } else {
+                        Ok(f64::NAN)
+                    }
+                })
                 .collect::<Result<Vec<f64>>>()?;
             let Some(i) = (0..grid.len())
                 .filter(|&i| !vals[i].is_nan())
@@ -112,7 +129,11 @@ pub fn polish_valleys(obj: &Objective, start: Found) -> Result<Found> {
             let (mut x, mut fx) = (grid[i], vals[i]);
             let (lo, hi) = (grid[i.saturating_sub(1)], grid[(i + 1).min(grid.len() - 1)]);
             if lo < hi {
-                let m = scalar::brent_minimize(|a| lsq::chi2(obj, &at(a)), lo, hi, 1e-12)?;
+                // Along a principal axis chi2 ~ chi2_min + s (a/sd)^2 (s the chi2 scale), so
+                // missing the line's minimum by 1e-4 sd costs 1e-8 s, a hundredth of the
+                // search's tolerance (1e-6 s and more).
+                let tol = 1e-4 * sd;
+                let m = scalar::brent_minimize(|a| lsq::chi2(obj, &at(a)), lo, hi, tol)?;
                 if m.fx < fx {
                     (x, fx) = (m.x, m.fx);
                 }
@@ -332,7 +353,7 @@ mod tests {
         };
         let f = polish_newton(&obj, start.clone()).unwrap();
         assert!(close(&f.theta, &truth) && f.chi2 < 1e-12, "{f:?}");
-        let f = polish_valleys(&obj, start).unwrap();
+        let f = polish_valleys(&obj, start, &|_| true).unwrap();
         assert!(close(&f.theta, &truth) && f.chi2 < 1e-12, "{f:?}");
     }
 }

@@ -28,7 +28,8 @@
 //! power law's exponents with A profiled out. For `min`, starts mirrored across nearby kinks. The
 //! minima within 1e-5 relative of the best are finished: Brent on the profiles where
 //! Levenberg-Marquardt stopped on a kink of `min`, damped Newton where it ran out of iterations,
-//! line searches along the covariance's axes. The reported minimum is the lowest point found. A
+//! line searches along the covariance's axes (whose scans skip the points where the bounds
+//! already exclude chi2 below U - tau: [`super::bnb::Bnb::may_hold_below`]). The reported minimum is the lowest point found. A
 //! point below the certified bound would contradict the bounds: a warning, never ignored.
 //!
 //! **Costs**: e_vm and e_pm are tabulated once per grid value of eta or sigma_y (a row over all
@@ -310,6 +311,10 @@ fn run<L: Landscape>(
             }
         }
         let close = unique;
+        // Where the bounds exclude chi2 below U - tau the valleys' scans need not look.
+        let u = upper.min(best);
+        let target = u - tau_of(u);
+        let may_beat = |th: &[f64]| bnb.may_hold_below(axes_of(th), target);
         for b in close.into_iter().take(MAX_FINISH) {
             n_polish += 1;
             // Levenberg-Marquardt that ran out of iterations (creeping along a narrow curved
@@ -332,7 +337,7 @@ fn run<L: Landscape>(
                     break;
                 }
             }
-            let v = polish_valleys(obj, v)?;
+            let v = polish_valleys(obj, v, &may_beat)?;
             polished.push(v);
         }
     }

@@ -115,3 +115,72 @@ fn certifies_two_wells_and_proposes_both() {
         "{c:?}"
     );
 }
+
+/// Every point of a 201 x 81 sample of the box that `may_hold_below` excludes lies at or above
+/// the target; returns how many were excluded and how many points lie below the target (so
+/// that the check is not vacuous).
+fn check_exclusions(b: &Bnb<TwoWells>, target: f64) -> (usize, usize) {
+    let f = |x: f64, y: f64| g(x) + (y - 0.3f64).powi(2);
+    let (mut excluded, mut below) = (0, 0);
+    for i in 0..=200 {
+        for j in 0..=80 {
+            let (x, y) = (-5.0 + 0.05 * i as f64, -1.0 + 0.025 * j as f64);
+            below += usize::from(f(x, y) < target);
+            if !b.may_hold_below([x, y], target) {
+                excluded += 1;
+                assert!(f(x, y) >= target, "({x}, {y}): {} < {target}", f(x, y));
+            }
+        }
+    }
+    (excluded, below)
+}
+
+#[test]
+fn points_the_bounds_exclude_are_above_the_target() {
+    // Loose bounds: fine cells (resolution 0.05) around the global minimum (2, 0.3), whose best
+    // node lies above it; then a budget of 200 cells that leaves cells unresolved. In both the
+    // target U - tau (U the best node) lies above f somewhere on the sample, and no point below
+    // it may be excluded (the proof the valleys' scans rely on; f is exact, the bounds loose).
+    let limits = Limits {
+        max_cells: 100_000,
+        max_rows: 10_000,
+    };
+    let wells = || TwoWells {
+        x: vec![],
+        y: vec![],
+        loose: true,
+    };
+    let tau = 1e-6;
+    let mut b = Bnb::new(wells(), [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], limits);
+    assert!(b.may_hold_below([-1.0, 0.3], -1.0), "nothing proved yet");
+    b.set_resolution([0.05, 0.05]);
+    b.refine(f64::INFINITY, &|_| tau);
+    let (_, _, u) = b.best_node().unwrap();
+    assert!(b.certificate(u).fine_cells > 0 && u > 0.0, "{u}");
+    let target = u - tau;
+    assert!(b.may_hold_below([2.0, 0.3], target));
+    assert!(!b.may_hold_below([-1.0, 0.3], target));
+    assert!(!b.may_hold_below([2.0, -0.9], target));
+    assert!(b.may_hold_below([f64::NAN, 0.3], target));
+    let (excluded, below) = check_exclusions(&b, target);
+    assert!(
+        excluded > 15_000 && below > 0,
+        "{excluded} excluded, {below} below"
+    );
+    // A target below every bound excludes everything.
+    assert!(!b.may_hold_below([2.0, 0.3], -1e9));
+
+    let small = Limits {
+        max_cells: 200,
+        max_rows: 10_000,
+    };
+    let mut b = Bnb::new(wells(), [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], small);
+    b.refine(f64::INFINITY, &|_| tau);
+    let (_, _, u) = b.best_node().unwrap();
+    assert!(!b.certificate(u).reasons.is_empty());
+    let (excluded, below) = check_exclusions(&b, u - tau);
+    assert!(
+        excluded > 0 && below > 0,
+        "{excluded} excluded, {below} below"
+    );
+}
