@@ -84,6 +84,22 @@ fn shipped_example_prefers_the_regime_switch() {
         "{}",
         r.stderr
     );
+    // The certificate's text says where it rests on the polishes: the cells the JSON counts.
+    let fine = min["global_search"]["fine_cells"].as_u64().unwrap();
+    assert!(
+        fine > 0,
+        "120 points keep first-order bounds: cells at the resolution remain"
+    );
+    let table = run(&["fit", "data/fig7_nylon.csv", "--material", "nylon"]);
+    let line = table
+        .stdout
+        .lines()
+        .find(|l| l.contains("min: global minimum certified"))
+        .unwrap_or_else(|| panic!("{}", table.stdout));
+    assert!(
+        line.contains(&format!("outside {fine} cells")) && !line.contains("anywhere"),
+        "{line}"
+    );
 }
 
 #[test]
@@ -153,7 +169,8 @@ fn json_shape_is_stable() {
                 "gap_chi2",
                 "tolerance_chi2",
                 "cells",
-                "polishes"
+                "polishes",
+                "fine_cells"
             ]
         );
         assert!(f["warnings"].is_array());

@@ -461,6 +461,11 @@ impl<L: Landscape> Bnb<L> {
             .any(|c| !(c.bound.lb >= target) && inside(c))
     }
 
+    /// How many cells were left at the resolution with a bound below `target`.
+    pub fn fine_cells_below(&self, target: f64) -> u64 {
+        self.fine.iter().filter(|c| !(c.bound.lb >= target)).count() as u64
+    }
+
     /// The certificate for `upper` (see [`Certificate`]).
     pub fn certificate(&self, upper: f64) -> Certificate {
         let lowest = |it: &mut dyn Iterator<Item = &Cell>| {

@@ -53,8 +53,10 @@ pub struct ParamEstimate {
 /// What the global search established (see [`super::search`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct GlobalSearch {
-    /// True when the lower bounds exclude, everywhere in the search box, any chi2 more than
-    /// `gap_chi2` below the reported minimum.
+    /// True when the lower bounds exclude, everywhere in the search box outside `fine_cells`
+    /// cells at the search's resolution around the minima, any chi2 more than `gap_chi2` below
+    /// the reported minimum, and every local minimum of the grid that could beat it was
+    /// polished ([`super::search`]).
     pub certified: bool,
     /// How far below the reported chi2 the global minimum could lie at most (certified only).
     pub gap_chi2: f64,
@@ -64,6 +66,10 @@ pub struct GlobalSearch {
     pub cells: u64,
     /// Local minimisations run (one per candidate minimum that could beat the best).
     pub polishes: u64,
+    /// Cells left at the search's resolution (a fraction of a standard error) whose bound lies
+    /// below the reported minimum minus the tolerance: inside them the answer rests on the
+    /// local polishes and line scans, not on the bounds (0: the bounds alone certify it).
+    pub fine_cells: u64,
 }
 
 /// The result of fitting one model.

@@ -102,6 +102,7 @@ pub fn global_minimum(obj: &Objective, options: &FitOptions) -> Result<SearchOut
                 tolerance_chi2: tolerance(obj, best.chi2),
                 cells: 0,
                 polishes: 1,
+                fine_cells: 0,
             },
             best,
             warnings: vec![
@@ -448,6 +449,7 @@ fn run<L: Landscape>(
             tolerance_chi2: tau,
             cells: bnb.cells,
             polishes: n_polish,
+            fine_cells: bnb.fine_cells_below(best.chi2 - tau),
         },
         best,
         warnings,

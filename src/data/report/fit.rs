@@ -110,6 +110,7 @@ fn fit_json(f: &FitResult) -> Value {
             "tolerance_chi2": num(g.tolerance_chi2),
             "cells": g.cells,
             "polishes": g.polishes,
+            "fine_cells": g.fine_cells,
         }),
     );
     m.insert("evaluations".into(), json!(f.evaluations));

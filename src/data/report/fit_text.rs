@@ -329,9 +329,20 @@ fn note_lines(set: &FitSet) -> Vec<String> {
         }
         let g = &f.global;
         if g.certified {
+            // Where cells were left at the resolution the bounds do not cover them: said so.
+            let region = if g.fine_cells == 0 {
+                "anywhere in the search box".to_string()
+            } else {
+                format!(
+                    "in the search box outside {} cell{} of a fraction of a standard error \
+                     around the minima, where it rests on the local polishes",
+                    g.fine_cells,
+                    if g.fine_cells == 1 { "" } else { "s" }
+                )
+            };
             out.push(format!(
-                "{}: global minimum certified: no chi2 below it by more than {} anywhere in the \
-                 search box ({} cells, {} polishes)",
+                "{}: global minimum certified: no chi2 below it by more than {} {region} ({} \
+                 cells, {} polishes)",
                 f.model.name(),
                 short(g.gap_chi2, 2),
                 g.cells,

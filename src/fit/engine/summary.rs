@@ -194,6 +194,7 @@ pub(super) fn summarise(
             tolerance_chi2: 0.0,
             cells: 0,
             polishes: 0,
+            fine_cells: 0,
         },
         evaluations: 0,
         profile_evaluations: 0,
