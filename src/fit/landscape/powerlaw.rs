@@ -10,6 +10,7 @@ use std::cell::RefCell;
 use std::collections::HashMap;
 
 mod first_order;
+mod lanes;
 mod linearized;
 
 /// Relative widening of the z ranges of the power law: a few rounding errors of exp and a
