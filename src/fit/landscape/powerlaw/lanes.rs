@@ -28,6 +28,21 @@ pub(super) fn load(s: &[f64], b: usize) -> f64x4 {
     f64x4::new(g)
 }
 
+/// `g` into `s[b..b + 4]`, the lanes past the end of `s` dropped.
+#[inline(always)]
+pub(super) fn store(s: &mut [f64], b: usize, g: f64x4) {
+    let g = g.to_array();
+    if let Some(d) = s.get_mut(b..b + LANES) {
+        // A copy of fixed length (inlined; a variable one is a call to memmove).
+        d.copy_from_slice(&g);
+        return;
+    }
+    let from = b.min(s.len());
+    for (d, v) in s[from..].iter_mut().zip(g) {
+        *d = v;
+    }
+}
+
 /// The sum of the lanes, (l0 + l1) + (l2 + l3).
 #[inline(always)]
 pub(super) fn total(v: f64x4) -> f64 {
@@ -45,6 +60,10 @@ mod tests {
         assert_eq!(load(&s, 0).to_array(), [1.0, 2.0, 3.0, 4.0]);
         assert_eq!(load(&s, 4).to_array(), [5.0, 6.0, 0.0, 0.0]);
         assert_eq!(load(&s, 8).to_array(), [0.0; 4]);
+        let mut t = [0.0; 6];
+        store(&mut t, 0, f64x4::new([1.0, 2.0, 3.0, 4.0]));
+        store(&mut t, 4, f64x4::new([5.0, 6.0, 7.0, 8.0]));
+        assert_eq!(t, s);
         // The pairing is the stated one: 1e16 + 1 rounds to 1e16 (ties to even), so
         // (1e16 + 1) + (-1e16 + 1) is 0, where the sum in order would be 1.
         assert_eq!(total(f64x4::new([1e16, 1.0, -1e16, 1.0])), 0.0);
