@@ -9,7 +9,7 @@ use lanes::{load, store};
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::collections::HashMap;
-use wide::f64x4;
+use wide::{CmpGt, f64x4};
 
 mod first_order;
 mod lanes;
@@ -324,6 +324,9 @@ impl PowerLaw {
             let (o1, o2, o3) = (&mut o1[..len], &mut o2[..len], &mut o3[..len]);
             let (c1, c2, w) = (&c1[r.clone()], &c2[r.clone()], &w[r]);
             let mut s = f64x4::ZERO;
+            // All ones while every centre so far is finite and positive (padding lanes, 0,
+            // clear it too: then the check below runs over the chunk, finding nothing to redo).
+            let mut good = f64x4::splat(f64::from_bits(u64::MAX));
             for b in (0..len).step_by(lanes::LANES) {
                 let (a0, a1, b0, b1) = (load(za0, b), load(za1, b), load(zb0, b), load(zb1, b));
                 let (amin, amax) = (a0.fast_min(a1), a0.fast_max(a1));
@@ -338,11 +341,14 @@ impl PowerLaw {
                     let zc = (a0 * a1 * (b0 * b1)).sqrt();
                     let m =
                         load(c1, b).abs() * f64x4::splat(ha) + load(c2, b).abs() * f64x4::splat(hb);
+                    good = good & zc.is_finite() & zc.cmp_gt(f64x4::ZERO);
                     store(o2, b, zc);
                     store(o3, b, zc * linearized::remainder_bound_x4(m, e_max));
                 }
             }
-            if let Some([ha, hb]) = h {
+            if let Some([ha, hb]) = h
+                && !good.all()
+            {
                 for j in 0..len {
                     if !(o2[j].is_finite() && o2[j] > 0.0) {
                         let (amin, amax) = (za0[j].min(za1[j]), za0[j].max(za1[j]));
