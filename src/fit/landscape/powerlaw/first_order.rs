@@ -45,17 +45,26 @@ impl PowerLaw {
     }
 
     /// The least-squares amplitude A with every point's z at the middle of its range: the start
-    /// of both bound iterations.
+    /// of both bound iterations (four points at a time, [`super::lanes`]).
     fn amplitude_at_middle(&self, zlo: &[f64], zhi: &[f64]) -> f64 {
         let (y, w) = (&self.y[..], &self.w[..]);
+        let half = f64x4::splat(0.5);
         let [num, den] = sums::sum(self.n, |points| {
-            let (mut num, mut den) = (0.0, 0.0);
-            for i in points {
-                let z = 0.5 * (zlo[i] + zhi[i]);
-                num += w[i] * z * y[i];
-                den += w[i] * z * z;
+            let r = points;
+            let (y, w, zlo, zhi) = (
+                &y[r.clone()],
+                &w[r.clone()],
+                &zlo[r.clone()],
+                &zhi[r.clone()],
+            );
+            let (mut num, mut den) = (f64x4::ZERO, f64x4::ZERO);
+            for b in (0..r.len()).step_by(lanes::LANES) {
+                let z = half * (load(zlo, b) + load(zhi, b));
+                let wz = load(w, b) * z;
+                num += wz * load(y, b);
+                den += wz * z;
             }
-            [num, den]
+            [lanes::total(num), lanes::total(den)]
         });
         num / den
     }
