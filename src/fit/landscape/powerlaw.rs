@@ -5,11 +5,14 @@ use super::super::bnb::{Bound, Landscape};
 use super::super::models::{POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S, powerlaw_d_mm};
 use super::super::objective::Objective;
 use super::super::sums;
+use lanes::{load, store};
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::collections::HashMap;
+use wide::{CmpGt, f64x4};
 
 mod first_order;
+mod lanes;
 mod linearized;
 
 /// Relative widening of the z ranges of the power law: a few rounding errors of exp and a
@@ -295,7 +298,7 @@ impl PowerLaw {
     /// The scratch arrays of the cell between rows `lo` and `hi`: zlo and zhi (widened by
     /// Z_SLACK), and with the half-widths `h` the centre's zc and the remainder zc R(M_i) of
     /// [`linearized`] (R's bound taking exp(M_i) <= exp(max M), no exp per point); returns
-    /// sum_i w_i zhi_i^2 (0 without `h`).
+    /// sum_i w_i zhi_i^2.
     fn fill_cell(
         &self,
         lo: [usize; 2],
@@ -307,10 +310,11 @@ impl PowerLaw {
         let (zb0, zb1) = (self.row(1, lo[1]), self.row(1, hi[1]));
         let (c1, c2, w) = (&self.c1[..], &self.c2[..], &self.w[..]);
         let e_max = h.map_or(0.0, |h| self.m_max(h).exp() * (1.0 + 1e-15));
-        // The points start..start + len into the chunk's slices: straight loops over slices
-        // without branches, which vectorise; a centre whose corners' product overflows or
-        // underflows (rare) is redone after, and the sum is taken in point order last (so the
-        // values are those of a loop point by point, to the last bit).
+        // The points start..start + len into the chunk's slices, four at a time ([`lanes`]),
+        // without branches; a centre whose corners' product overflows or underflows (rare) is
+        // redone after, point by point. Every value stored is the one a loop point by point
+        // would give, to the last bit; the sum is taken in lanes.
+        let (eps_lo, eps_hi) = (f64x4::splat(1.0 - Z_SLACK), f64x4::splat(1.0 + Z_SLACK));
         let chunk = |start: usize, o: [&mut [f64]; 4]| -> f64 {
             let [o0, o1, o2, o3] = o;
             let len = o0.len();
@@ -318,45 +322,45 @@ impl PowerLaw {
             let (za0, za1) = (&za0[r.clone()], &za1[r.clone()]);
             let (zb0, zb1) = (&zb0[r.clone()], &zb1[r.clone()]);
             let (o1, o2, o3) = (&mut o1[..len], &mut o2[..len], &mut o3[..len]);
-            for j in 0..len {
-                let (amin, amax) = (za0[j].min(za1[j]), za0[j].max(za1[j]));
-                let (bmin, bmax) = (zb0[j].min(zb1[j]), zb0[j].max(zb1[j]));
-                o0[j] = amin * bmin * (1.0 - Z_SLACK);
-                o1[j] = amax * bmax * (1.0 + Z_SLACK);
-            }
-            let Some([ha, hb]) = h else {
-                return 0.0;
-            };
             let (c1, c2, w) = (&c1[r.clone()], &c2[r.clone()], &w[r]);
-            let remainder = |j: usize, zc: f64| {
-                let m = c1[j].abs() * ha + c2[j].abs() * hb;
-                zc * linearized::remainder_bound(m, e_max)
-            };
-            // exp(-a_c c1 + b_c c2) = sqrt of the product of the corners' rows, which can
-            // overflow where the rows do not: then a square root each.
-            let mut redo = false;
-            for j in 0..len {
-                let zc = (za0[j] * za1[j] * (zb0[j] * zb1[j])).sqrt();
-                redo |= !(zc.is_finite() && zc > 0.0);
-                o2[j] = zc;
-                o3[j] = remainder(j, zc);
+            let mut s = f64x4::ZERO;
+            // All ones while every centre so far is finite and positive (padding lanes, 0,
+            // clear it too: then the check below runs over the chunk, finding nothing to redo).
+            let mut good = f64x4::splat(f64::from_bits(u64::MAX));
+            for b in (0..len).step_by(lanes::LANES) {
+                let (a0, a1, b0, b1) = (load(za0, b), load(za1, b), load(zb0, b), load(zb1, b));
+                let (amin, amax) = (a0.fast_min(a1), a0.fast_max(a1));
+                let (bmin, bmax) = (b0.fast_min(b1), b0.fast_max(b1));
+                let hi = amax * bmax * eps_hi;
+                store(o0, b, amin * bmin * eps_lo);
+                store(o1, b, hi);
+                s += load(w, b) * hi * hi;
+                if let Some([ha, hb]) = h {
+                    // exp(-a_c c1 + b_c c2) = sqrt of the product of the corners' rows, which
+                    // can overflow where the rows do not: redone below.
+                    let zc = (a0 * a1 * (b0 * b1)).sqrt();
+                    let m =
+                        load(c1, b).abs() * f64x4::splat(ha) + load(c2, b).abs() * f64x4::splat(hb);
+                    good = good & zc.is_finite() & zc.cmp_gt(f64x4::ZERO);
+                    store(o2, b, zc);
+                    store(o3, b, zc * linearized::remainder_bound_x4(m, e_max));
+                }
             }
-            if redo {
+            if let Some([ha, hb]) = h
+                && !good.all()
+            {
                 for j in 0..len {
                     if !(o2[j].is_finite() && o2[j] > 0.0) {
                         let (amin, amax) = (za0[j].min(za1[j]), za0[j].max(za1[j]));
                         let (bmin, bmax) = (zb0[j].min(zb1[j]), zb0[j].max(zb1[j]));
                         let zc = (amin.sqrt() * amax.sqrt()) * (bmin.sqrt() * bmax.sqrt());
+                        let m = c1[j].abs() * ha + c2[j].abs() * hb;
                         o2[j] = zc;
-                        o3[j] = remainder(j, zc);
+                        o3[j] = zc * linearized::remainder_bound(m, e_max);
                     }
                 }
             }
-            let mut s = 0.0;
-            for j in 0..len {
-                s += w[j] * o1[j] * o1[j];
-            }
-            s
+            lanes::total(s)
         };
         let n = self.n;
         let [o0, o1, o2, o3] = out;

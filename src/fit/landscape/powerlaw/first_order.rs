@@ -3,45 +3,68 @@
 //! below by the crossing of two tangents with slopes of opposite signs.
 
 use super::super::super::sums;
+use super::lanes::{self, load};
 use super::{POWERLAW_BOUND_ITERS, PowerLaw};
+use wide::{CmpGt, f64x4};
 
 impl PowerLaw {
-    /// f(A), f'(A) and f''(A) (from the right) of the module doc. Branch-free (selects), so it
-    /// vectorises; every input is finite (rows are checked when they are made).
+    /// f(A), f'(A) and f''(A) (from the right) of the module doc. Four points at a time,
+    /// branch-free ([`super::lanes`]); every input is finite (rows are checked when they are
+    /// made).
     fn f_slope_curv(&self, zlo: &[f64], zhi: &[f64], a: f64) -> (f64, f64, f64) {
         let (y, w) = (&self.y[..], &self.w[..]);
+        let (a, zero) = (f64x4::splat(a), f64x4::ZERO);
         let [f, d, h] = sums::sum(self.n, |points| {
-            let (mut f, mut d, mut h) = (0.0, 0.0, 0.0);
-            for i in points {
-                let w = w[i];
-                let u = a * zlo[i] - y[i];
-                let v = y[i] - a * zhi[i];
+            let r = points;
+            let (y, w, zlo, zhi) = (
+                &y[r.clone()],
+                &w[r.clone()],
+                &zlo[r.clone()],
+                &zhi[r.clone()],
+            );
+            let (mut f, mut d, mut h) = (zero, zero, zero);
+            for b in (0..r.len()).step_by(lanes::LANES) {
+                let (y, w, zlo, zhi) = (load(y, b), load(w, b), load(zlo, b), load(zhi, b));
+                let u = a * zlo - y;
+                let v = y - a * zhi;
                 // At most one of u, v is positive (zlo <= zhi).
-                let pu = if u > 0.0 { u } else { 0.0 };
-                let pv = if v > 0.0 { v } else { 0.0 };
-                let cu = if u > 0.0 { zlo[i] } else { 0.0 };
-                let cv = if v > 0.0 { zhi[i] } else { 0.0 };
+                let (pos_u, pos_v) = (u.cmp_gt(zero), v.cmp_gt(zero));
+                let (pu, pv) = (pos_u & u, pos_v & v);
+                let (cu, cv) = (pos_u & zlo, pos_v & zhi);
                 f += w * (pu * pu + pv * pv);
-                d += 2.0 * w * (zlo[i] * pu - zhi[i] * pv);
-                h += 2.0 * w * (cu * cu + cv * cv);
+                d += w * (zlo * pu - zhi * pv);
+                h += w * (cu * cu + cv * cv);
             }
-            [f, d, h]
+            [
+                lanes::total(f),
+                2.0 * lanes::total(d),
+                2.0 * lanes::total(h),
+            ]
         });
         (f, d, h)
     }
 
     /// The least-squares amplitude A with every point's z at the middle of its range: the start
-    /// of both bound iterations.
+    /// of both bound iterations (four points at a time, [`super::lanes`]).
     fn amplitude_at_middle(&self, zlo: &[f64], zhi: &[f64]) -> f64 {
         let (y, w) = (&self.y[..], &self.w[..]);
+        let half = f64x4::splat(0.5);
         let [num, den] = sums::sum(self.n, |points| {
-            let (mut num, mut den) = (0.0, 0.0);
-            for i in points {
-                let z = 0.5 * (zlo[i] + zhi[i]);
-                num += w[i] * z * y[i];
-                den += w[i] * z * z;
+            let r = points;
+            let (y, w, zlo, zhi) = (
+                &y[r.clone()],
+                &w[r.clone()],
+                &zlo[r.clone()],
+                &zhi[r.clone()],
+            );
+            let (mut num, mut den) = (f64x4::ZERO, f64x4::ZERO);
+            for b in (0..r.len()).step_by(lanes::LANES) {
+                let z = half * (load(zlo, b) + load(zhi, b));
+                let wz = load(w, b) * z;
+                num += wz * load(y, b);
+                den += wz * z;
             }
-            [num, den]
+            [lanes::total(num), lanes::total(den)]
         });
         num / den
     }
