@@ -42,7 +42,12 @@ fn bench(c: &mut Criterion) {
         let obj = Objective::new(&ev, kind).unwrap();
         let mut l = Separable::new(&obj, kind == ModelKind::Min, [true, true]);
         let (t0, t1) = (f64::ln(eta), f64::ln(sigma_y));
-        for (axis, t) in [(0, t0 - 0.004), (0, t0 + 0.006), (1, t1 - 0.006), (1, t1 + 0.004)] {
+        for (axis, t) in [
+            (0, t0 - 0.004),
+            (0, t0 + 0.006),
+            (1, t1 - 0.006),
+            (1, t1 + 0.004),
+        ] {
             l.add_row(axis, t).unwrap();
         }
         let corners = [[0, 0], [1, 0], [0, 1], [1, 1]].map(|r| l.node(r));

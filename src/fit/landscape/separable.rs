@@ -228,6 +228,14 @@ impl<'a> Separable<'a> {
                 loose: choose(s, *second),
             };
         }
+        // The sample's sums are those of the full pass thinned out: its Newton step (whose
+        // length does not depend on the scale of phi) points where the full pass's would, so the
+        // full passes start there, one pass ahead. Any point of the cell gives a valid bound.
+        if let Some((s, _)) = &sampled
+            && let Some(y) = newton_step(x, s.g, s.h)
+        {
+            x = y;
+        }
         let mut first = PassSums::default();
         let mut best: Option<([f64; 2], PassSums)> = None;
         let mut second = f64::NEG_INFINITY;
