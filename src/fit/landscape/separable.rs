@@ -183,9 +183,9 @@ impl<'a> Separable<'a> {
     }
 
     /// The cell bound: the larger of the first-order bound and tangent-plane bounds of the
-    /// convex relaxation phi (parent module's doc), at the cell's centre and at safeguarded
-    /// projected Newton steps towards phi's minimum (a step that does not lower phi is halved
-    /// back towards the best point), until the bound reaches `target`, phi itself falls below it
+    /// convex relaxation phi (parent module's doc), at the cell's centre (large data: at the
+    /// sampled pass's Newton step from it) and at safeguarded projected Newton steps towards
+    /// phi's minimum (a step that does not lower phi is halved back towards the best point), until the bound reaches `target`, phi itself falls below it
     /// (no bound of phi's minimum can reach it then), or MAX_PASSES (always, without a target).
     fn bound_with(&self, lo: [usize; 2], hi: [usize; 2], target: Option<f64>) -> Bound {
         let cell = self.cell(lo, hi);

@@ -1,9 +1,11 @@
 //! One point's terms of a pass over a cell (parent module's [`super::Separable::pass`]), in the
 //! form the compiler runs fast: no branches (each case's numbers computed and the right ones
-//! selected), the `min` and `product` rules as separate instances, not a flag tested per point.
+//! selected), the `min` and `product` rules as separate instances, not a flag tested per point,
+//! and a run of points formed a block at a time before its terms are summed in point order (the
+//! forming then proceeds several points at once).
 //!
-//! The arithmetic is, operation for operation, that of [`super::cell::Cell::first_order_gap`]
-//! and [`super::cell::Cell::enclosure`] followed by the tangent terms (docs/physics.md §7.4),
+//! The arithmetic is, operation for operation, that of [`Cell::first_order_gap`]
+//! and `Cell::enclosure` (cell.rs) followed by the tangent terms (docs/physics.md §7.4),
 //! so every term, and every sum, is the same to the last bit (a test compares them), and the
 //! rounding margins stated there hold unchanged. A term of a point inside its interval is
 //! added as a zero (its distance and gradient selected to 0): adding +-0 to a sum leaves it
@@ -28,7 +30,7 @@ fn sel(c: bool, a: f64, b: f64) -> f64 {
     if c { a } else { b }
 }
 
-/// a + b s + c u at x = (s, u), in [`super::cell::Aff`]'s order of operations.
+/// a + b s + c u at x = (s, u), in `Aff::at`'s order of operations.
 #[inline(always)]
 fn at(p: [f64; 3], x: [f64; 2]) -> f64 {
     p[0] + p[1] * x[0] + p[2] * x[1]
@@ -50,15 +52,16 @@ pub(super) struct Point {
     pub w: f64,
 }
 
-/// Adds point `p`'s terms at cell coordinates x: the first-order bound's (if FIRST) and the
-/// relaxation's (if SECOND), under the min rule (MIN) or the product.
+/// Point `p`'s terms at cell coordinates x, in [`Terms`]' order (first; phi; g; g_abs; h): the
+/// first-order bound's (if FIRST, else 0) and the relaxation's (if SECOND, else 0), under the
+/// min rule (MIN) or the product.
 #[inline(always)]
-pub(super) fn add<const MIN: bool, const FIRST: bool, const SECOND: bool>(
+fn terms<const MIN: bool, const FIRST: bool, const SECOND: bool>(
     cell: &Cell,
     x: [f64; 2],
     p: Point,
-    s: &mut Terms,
-) {
+) -> [f64; 9] {
+    let mut t = [0.0; 9];
     let Point {
         f0,
         f1,
@@ -76,10 +79,10 @@ pub(super) fn add<const MIN: bool, const FIRST: bool, const SECOND: bool>(
             bottom - e,
             sel(e > top + cell.slack, e - top - cell.slack, 0.0),
         );
-        s.first += w * d * d;
+        t[0] = w * d * d;
     }
     if !SECOND {
-        return;
+        return t;
     }
     // The factors' bands (Cell::bands): half-width c + a t (1 - t), the quadratic one while q
     // is below the corner difference, else the constant one.
@@ -169,17 +172,49 @@ pub(super) fn add<const MIN: bool, const FIRST: bool, const SECOND: bool>(
     let d = sel(below, lo_v - r - e, sel(above, e - hi_v - r, 0.0));
     let grad = [0, 1].map(|k| sel(below, glo[k] - gr[k], sel(above, -ghi[k] - gr[k], 0.0)));
     let wd = w * d;
-    s.phi += wd * d;
+    t[1] = wd * d;
     for (k, gk) in grad.iter().enumerate() {
-        s.g[k] += 2.0 * wd * gk;
-        s.g_abs[k] += (2.0 * wd * gk).abs();
+        t[2 + k] = 2.0 * wd * gk;
+        t[4 + k] = (2.0 * wd * gk).abs();
     }
     // Hessian of w d^2: 2 w (grad grad^T + d diag(2 r2)) (R's curvature is -2 r2).
     let w2 = 2.0 * w;
-    s.h[0] += w2 * (grad[0] * grad[0] + 2.0 * d * r2[0]);
-    s.h[1] += w2 * grad[0] * grad[1];
-    s.h[2] += w2 * (grad[1] * grad[1] + 2.0 * d * r2[1]);
+    t[6] = w2 * (grad[0] * grad[0] + 2.0 * d * r2[0]);
+    t[7] = w2 * grad[0] * grad[1];
+    t[8] = w2 * (grad[1] * grad[1] + 2.0 * d * r2[1]);
+    t
 }
+
+/// Adds point `p`'s terms at x to `s`.
+#[inline(always)]
+pub(super) fn add<const MIN: bool, const FIRST: bool, const SECOND: bool>(
+    cell: &Cell,
+    x: [f64; 2],
+    p: Point,
+    s: &mut Terms,
+) {
+    s.add(terms::<MIN, FIRST, SECOND>(cell, x, p));
+}
+
+impl Terms {
+    #[inline(always)]
+    fn add(&mut self, t: [f64; 9]) {
+        self.first += t[0];
+        self.phi += t[1];
+        self.g[0] += t[2];
+        self.g[1] += t[3];
+        self.g_abs[0] += t[4];
+        self.g_abs[1] += t[5];
+        self.h[0] += t[6];
+        self.h[1] += t[7];
+        self.h[2] += t[8];
+    }
+}
+
+/// Points per block of [`run`]: the terms of a block are formed first (a loop without a
+/// carried sum, which the compiler runs several points at a time) and then added in point
+/// order. 64 points x 9 terms stay in the first-level cache.
+const BLOCK: usize = 64;
 
 /// The terms of points `range` (consecutive) at x, summed in point order.
 #[inline(always)]
@@ -191,21 +226,35 @@ pub(super) fn run<const MIN: bool, const FIRST: bool, const SECOND: bool>(
     range: std::ops::Range<usize>,
 ) -> Terms {
     let mut s = Terms::default();
-    let (f0, f1) = (&cell.f0[range.clone()], &cell.f1[range.clone()]);
-    let (g0, g1) = (&cell.g0[range.clone()], &cell.g1[range.clone()]);
-    let (e, w) = (&e[range.clone()], &w[range]);
-    let n = f0.len();
-    let (f1, g0, g1, e, w) = (&f1[..n], &g0[..n], &g1[..n], &e[..n], &w[..n]);
-    for j in 0..n {
-        let p = Point {
-            f0: f0[j],
-            f1: f1[j],
-            g0: g0[j],
-            g1: g1[j],
-            e: e[j],
-            w: w[j],
-        };
-        add::<MIN, FIRST, SECOND>(cell, x, p, &mut s);
+    let mut block = [[0.0; BLOCK]; 9];
+    let mut start = range.start;
+    while start < range.end {
+        let end = (start + BLOCK).min(range.end);
+        let (f0, f1) = (&cell.f0[start..end], &cell.f1[start..end]);
+        let (g0, g1) = (&cell.g0[start..end], &cell.g1[start..end]);
+        let (e, w) = (&e[start..end], &w[start..end]);
+        let m = f0.len();
+        let (f1, g0, g1, e, w) = (&f1[..m], &g0[..m], &g1[..m], &e[..m], &w[..m]);
+        for j in 0..m {
+            let p = Point {
+                f0: f0[j],
+                f1: f1[j],
+                g0: g0[j],
+                g1: g1[j],
+                e: e[j],
+                w: w[j],
+            };
+            let t = terms::<MIN, FIRST, SECOND>(cell, x, p);
+            for (b, tk) in block.iter_mut().zip(t) {
+                b[j] = tk;
+            }
+        }
+        // Point j's nine terms sit in nine columns at index j.
+        #[allow(clippy::needless_range_loop)]
+        for j in 0..m {
+            s.add(std::array::from_fn(|k| block[k][j]));
+        }
+        start = end;
     }
     s
 }
