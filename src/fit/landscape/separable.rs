@@ -6,7 +6,9 @@ use super::super::objective::Objective;
 use super::super::sums;
 
 mod cell;
-use cell::{CURVATURE, Cell, ROUND, pick};
+mod kernel;
+use cell::{CURVATURE, Cell, ROUND};
+use kernel::{Point, Terms};
 
 /// For large data (see [`sums`]) the looseness of a cell (which axis to split) is estimated
 /// from every LOOSE_STRIDE-th point: it decides nothing about the cell (13, prime, so that data
@@ -98,60 +100,39 @@ impl<'a> Separable<'a> {
 
     /// One pass over the points at cell coordinates x, or (`sample`) over every
     /// LOOSE_STRIDE-th point of each chunk; the first pass and a sample also sum the first-order
-    /// bound, and the loosenesses (for large data, only a sample does).
+    /// bound, and the loosenesses (for large data, only a sample does). The per-point terms are
+    /// [`kernel::add`]'s, one instance per rule and kind of pass.
     fn pass(&self, cell: &Cell, x: [f64; 2], first: bool, sample: bool) -> PassSums {
-        let (e, w) = (&self.e[..], &self.w[..]);
         let first = first || sample;
-        let second_order = self.second_order;
-        let point = |i: usize, s: &mut PassSums| {
-            let ei = e[i];
-            if first {
-                let d = cell.first_order_gap(i, ei);
-                s.first += w[i] * d * d;
-            }
-            if !second_order {
-                return;
-            }
-            let enc = cell.enclosure(i);
-            let (lo, glo) = pick(&enc.lo, x, false);
-            let (hi, ghi) = pick(&enc.hi, x, true);
-            let r = enc.r0 + enc.r2[0] * x[0] * (1.0 - x[0]) + enc.r2[1] * x[1] * (1.0 - x[1]);
-            let gr = [
-                enc.r2[0] * (1.0 - 2.0 * x[0]),
-                enc.r2[1] * (1.0 - 2.0 * x[1]),
-            ];
-            // phi_i = w dist(e, [lo - R, hi + R])^2: convex in x (lo - R convex, hi + R
-            // concave); the gradient of the end that e lies beyond, pointing away from e.
-            let (d, grad) = if ei < lo - r {
-                (lo - r - ei, [glo[0] - gr[0], glo[1] - gr[1]])
-            } else if ei > hi + r {
-                (ei - hi - r, [-ghi[0] - gr[0], -ghi[1] - gr[1]])
-            } else {
-                return;
-            };
-            let wd = w[i] * d;
-            s.phi += wd * d;
-            for (k, gk) in grad.iter().enumerate() {
-                s.g[k] += 2.0 * wd * gk;
-                s.g_abs[k] += (2.0 * wd * gk).abs();
-            }
-            // Hessian of w d^2: 2 w (grad grad^T + d diag(2 r2)) (R's curvature is -2 r2).
-            let w2 = 2.0 * w[i];
-            s.h[0] += w2 * (grad[0] * grad[0] + 2.0 * d * enc.r2[0]);
-            s.h[1] += w2 * grad[0] * grad[1];
-            s.h[2] += w2 * (grad[1] * grad[1] + 2.0 * d * enc.r2[1]);
-        };
-        let min_rule = self.min_rule;
+        match (self.min_rule, first, self.second_order) {
+            (false, false, false) => self.pass_as::<false, false, false>(cell, x, sample),
+            (false, false, true) => self.pass_as::<false, false, true>(cell, x, sample),
+            (false, true, false) => self.pass_as::<false, true, false>(cell, x, sample),
+            (false, true, true) => self.pass_as::<false, true, true>(cell, x, sample),
+            (true, false, false) => self.pass_as::<true, false, false>(cell, x, sample),
+            (true, false, true) => self.pass_as::<true, false, true>(cell, x, sample),
+            (true, true, false) => self.pass_as::<true, true, false>(cell, x, sample),
+            (true, true, true) => self.pass_as::<true, true, true>(cell, x, sample),
+        }
+    }
+
+    fn pass_as<const MIN: bool, const FIRST: bool, const SECOND: bool>(
+        &self,
+        cell: &Cell,
+        x: [f64; 2],
+        sample: bool,
+    ) -> PassSums {
+        let (e, w) = (&self.e[..], &self.w[..]);
         let loose = |i: usize, s: &mut PassSums| {
             let (f0, f1, g0, g1) = (cell.f0[i], cell.f1[i], cell.g0[i], cell.g1[i]);
-            let c = |a: f64, b: f64| if min_rule { a.min(b) } else { a * b };
+            let c = |a: f64, b: f64| if MIN { a.min(b) } else { a * b };
             let top = c(f0, g1);
             let r = (top - e[i]).abs();
             let d0 = top - c(f1, g1);
             let d1 = top - c(f0, g0);
             s.loose1[0] += w[i] * d0 * (r + d0);
             s.loose1[1] += w[i] * d1 * (r + d1);
-            if second_order {
+            if SECOND {
                 let l2 = cell.loose_second(i, w[i], e[i]);
                 s.loose2[0] += l2[0];
                 s.loose2[1] += l2[1];
@@ -160,25 +141,35 @@ impl<'a> Separable<'a> {
         let large = sums::is_large(self.n);
         let v = sums::sum(self.n, |points| {
             let mut s = PassSums::default();
-            if sample {
+            let t = if sample {
+                let mut t = Terms::default();
                 for i in points.step_by(LOOSE_STRIDE) {
-                    point(i, &mut s);
+                    let p = Point {
+                        f0: cell.f0[i],
+                        f1: cell.f1[i],
+                        g0: cell.g0[i],
+                        g1: cell.g1[i],
+                        e: e[i],
+                        w: w[i],
+                    };
+                    kernel::add::<MIN, FIRST, SECOND>(cell, x, p, &mut t);
                     loose(i, &mut s);
                 }
+                t
             } else {
-                for i in points {
-                    point(i, &mut s);
-                    if first && !large {
+                if FIRST && !large {
+                    for i in points.clone() {
                         loose(i, &mut s);
                     }
                 }
-            }
-            let [g0, g1] = s.g;
-            let [h0, h1, h2] = s.h;
-            let [a0, a1] = s.g_abs;
+                kernel::run::<MIN, FIRST, SECOND>(cell, e, w, x, points)
+            };
+            let [g0, g1] = t.g;
+            let [h0, h1, h2] = t.h;
+            let [a0, a1] = t.g_abs;
             let [o0, o1] = s.loose1;
             let [n0, n1] = s.loose2;
-            [s.first, s.phi, g0, g1, h0, h1, h2, a0, a1, o0, o1, n0, n1]
+            [t.first, t.phi, g0, g1, h0, h1, h2, a0, a1, o0, o1, n0, n1]
         });
         PassSums {
             first: v[0],
@@ -192,9 +183,9 @@ impl<'a> Separable<'a> {
     }
 
     /// The cell bound: the larger of the first-order bound and tangent-plane bounds of the
-    /// convex relaxation phi (parent module's doc), at the cell's centre and at safeguarded
-    /// projected Newton steps towards phi's minimum (a step that does not lower phi is halved
-    /// back towards the best point), until the bound reaches `target`, phi itself falls below it
+    /// convex relaxation phi (parent module's doc), at the cell's centre (large data: at the
+    /// sampled pass's Newton step from it) and at safeguarded projected Newton steps towards
+    /// phi's minimum (a step that does not lower phi is halved back towards the best point), until the bound reaches `target`, phi itself falls below it
     /// (no bound of phi's minimum can reach it then), or MAX_PASSES (always, without a target).
     fn bound_with(&self, lo: [usize; 2], hi: [usize; 2], target: Option<f64>) -> Bound {
         let cell = self.cell(lo, hi);
@@ -236,6 +227,14 @@ impl<'a> Separable<'a> {
                 lb: s.first.max(*second),
                 loose: choose(s, *second),
             };
+        }
+        // The sample's sums are those of the full pass thinned out: its Newton step (whose
+        // length does not depend on the scale of phi) points where the full pass's would, so the
+        // full passes start there, one pass ahead. Any point of the cell gives a valid bound.
+        if let Some((s, _)) = &sampled
+            && let Some(y) = newton_step(x, s.g, s.h)
+        {
+            x = y;
         }
         let mut first = PassSums::default();
         let mut best: Option<([f64; 2], PassSums)> = None;

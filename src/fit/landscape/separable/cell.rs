@@ -16,12 +16,14 @@ pub(super) const ROUND: f64 = 1e-14;
 
 /// An affine function a + b s + c u of a cell's coordinates (s, u) in [0, 1]^2.
 #[derive(Clone, Copy)]
+#[cfg(test)]
 pub(super) struct Aff {
     pub a: f64,
     pub b: f64,
     pub c: f64,
 }
 
+#[cfg(test)]
 impl Aff {
     #[inline(always)]
     fn at(&self, x: [f64; 2]) -> f64 {
@@ -32,6 +34,7 @@ impl Aff {
 /// One point's enclosure on a cell: the computed e lies in [max of `lo` - R, min of `hi` + R]
 /// at every (s, u) of the cell, R = r0 + r2[0] s (1 - s) + r2[1] u (1 - u) (a convex lower and
 /// a concave upper end).
+#[cfg(test)]
 pub(super) struct Enclosure {
     pub lo: [Aff; 2],
     pub hi: [Aff; 2],
@@ -57,6 +60,7 @@ impl Band {
 /// The larger (`upper` false) or smaller (`upper` true) of two affine functions at x, and the
 /// gradient of the one that attains it.
 #[inline(always)]
+#[cfg(test)]
 pub(super) fn pick(p: &[Aff; 2], x: [f64; 2], upper: bool) -> (f64, [f64; 2]) {
     let (v0, v1) = (p[0].at(x), p[1].at(x));
     let k = usize::from(if upper { v1 < v0 } else { v1 > v0 });
@@ -137,8 +141,10 @@ impl Cell<'_> {
 
     /// Point i's enclosure on the cell (see the parent module's doc). The monotone range is
     /// left out: it would put a kink of first order into the relaxation (the first-order bound
-    /// holds it, and the larger of the two bounds is taken).
-    #[inline(always)]
+    /// holds it, and the larger of the two bounds is taken). This is the enclosure as stated;
+    /// the passes run `kernel.rs`'s branch-free form of it, which the tests compare with this
+    /// one bit for bit.
+    #[cfg(test)]
     pub(super) fn enclosure(&self, i: usize) -> Enclosure {
         let (f0, f1, g0, g1) = (self.f0[i], self.f1[i], self.g0[i], self.g1[i]);
         let (df, dg) = (f1 - f0, g1 - g0);
