@@ -164,7 +164,7 @@ pub fn e_vm(
 
 /// e_pm of one contact at one speed for yield stress sigma_y (docs/physics.md §3 closed form).
 pub fn e_pm(contact: &Contact, v_m_s: f64, sigma_y_pa: f64) -> f64 {
-    plastic::rebound_e(v_m_s / contact.yield_velocity_m_s(sigma_y_pa))
+    plastic::e_of_u(v_m_s / contact.yield_velocity_m_s(sigma_y_pa))
 }
 
 /// The size variable of the power law, 4 R~ in mm (the diameter for identical spheres).
@@ -288,12 +288,12 @@ impl<'a> Evaluator<'a> {
     }
 
     pub fn e_pm(&self, i: usize, sigma_y_pa: f64) -> f64 {
-        plastic::rebound_e(self.data.obs[i].v_n_m_s / self.v_yield_m_s(i, sigma_y_pa))
+        plastic::e_of_u(self.data.obs[i].v_n_m_s / self.v_yield_m_s(i, sigma_y_pa))
     }
 
     /// e_pm of point `i` given sigma_y^(5/2) (computed once for all points).
     fn e_pm_s25(&self, i: usize, s25: f64) -> f64 {
-        plastic::rebound_e(self.data.obs[i].v_n_m_s / (self.v_yield_per_pa[i] * s25))
+        plastic::e_of_u(self.data.obs[i].v_n_m_s / (self.v_yield_per_pa[i] * s25))
     }
 
     /// e_pm of every point at sigma_y, into `out`.

@@ -89,13 +89,6 @@ pub fn rebound_u(u: f64) -> PlasticRebound {
     PlasticRebound { e, one_minus_e }
 }
 
-/// e of [`rebound_u`] alone (the same double): the fit needs e at every point on every
-/// evaluation, and 1 - e's cancellation-free form costs as much again.
-#[inline]
-pub fn rebound_e(u: f64) -> f64 {
-    e_and_w(u).0
-}
-
 /// e(u) and, between yield and [`U_ASYMPTOTE`], w = sqrt(30 u^2 - 5) (NaN elsewhere).
 #[inline(always)]
 fn e_and_w(u: f64) -> (f64, f64) {
@@ -140,7 +133,7 @@ fn e_and_w(u: f64) -> (f64, f64) {
 /// -e/4 from 1e20 on, where corr is 1 to rounding). Checked against central differences of
 /// [`rebound_u`] in the test below. NaN for NaN u; 0 for u = +inf (e = 0 there).
 pub fn e_and_slope_ln_u(u: f64) -> (f64, f64) {
-    let e = rebound_u(u).e;
+    let (e, w) = e_and_w(u);
     if u.is_nan() {
         return (e, f64::NAN);
     }
@@ -156,7 +149,6 @@ pub fn e_and_slope_ln_u(u: f64) -> (f64, f64) {
         let dcorr = -t * (A1 + t * (2.0 * A2 + t * 3.0 * A3));
         return (e, e * (dcorr / corr - 0.25));
     }
-    let w = (30.0 * u).mul_add(u, -5.0).sqrt();
     let q = 4.0 * (u - 1.0) * (u + 1.0) / (w + 5.0);
     let dlne = u * (4.0 * u / w) * (1.5 / (1.0 + 1.5 * q) - 0.25 / (1.0 + q)) - 1.0;
     (e, e * dlne)
@@ -168,9 +160,11 @@ pub fn try_rebound_u(u: f64) -> Result<PlasticRebound> {
     Ok(rebound_u(u))
 }
 
-/// e(u) alone; see [`rebound_u`].
+/// e(u) alone, the same double as [`rebound_u`]'s e: the fit needs e at every point on every
+/// evaluation, and 1 - e's cancellation-free form costs as much again (not left to the inliner).
+#[inline]
 pub fn e_of_u(u: f64) -> f64 {
-    rebound_u(u).e
+    e_and_w(u).0
 }
 
 /// The same closed form with q = -2/3 + (2/15) sqrt(30 u^2 - 5) and 1 - e taken as 1 - e: correct
@@ -289,7 +283,7 @@ mod tests {
         ];
         us.extend((0..2000).map(|k| 10f64.powf(-2.0 + 14.0 * k as f64 / 1999.0)));
         for u in us {
-            let (a, b) = (rebound_e(u), rebound_u(u).e);
+            let (a, b) = (e_of_u(u), rebound_u(u).e);
             assert!(a.to_bits() == b.to_bits(), "u {u}: {a} against {b}");
         }
     }
