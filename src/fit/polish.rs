@@ -129,10 +129,13 @@ pub fn polish_valleys(
             let (mut x, mut fx) = (grid[i], vals[i]);
             let (lo, hi) = (grid[i.saturating_sub(1)], grid[(i + 1).min(grid.len() - 1)]);
             if lo < hi {
-                // Along a principal axis chi2 ~ chi2_min + s (a/sd)^2 (s the chi2 scale), so
-                // missing the line's minimum by 1e-4 sd costs 1e-8 s, a hundredth of the
-                // search's tolerance (1e-6 s and more).
-                let tol = 1e-4 * sd;
+                // Along a principal axis chi2 ~ chi2_min + (a/sd)^2 (sd from the error bars as
+                // given), so missing the line's minimum by 1e-4 sqrt(min(s, 1)) sd costs at most
+                // 1e-8 s (s the chi2 scale, below 1 only without error bars), a hundredth of the
+                // search's tolerance (1e-6 s and more); not below the 1e-12 it was before (a
+                // NaN scale gives that).
+                let s = obj.scale(best.chi2).min(1.0);
+                let tol = (1e-4 * sd * s.sqrt()).max(1e-12);
                 let m = scalar::brent_minimize(|a| lsq::chi2(obj, &at(a)), lo, hi, tol)?;
                 if m.fx < fx {
                     (x, fx) = (m.x, m.fx);
