@@ -120,7 +120,7 @@ pub fn profile_intervals_of(
                 Ok(c)
             };
             // Crossings to 1e-7 in the internal coordinate (log parameters: 1e-7 relative).
-            let c = profile_crossing(profile, theta[j], limit, step, threshold, 1e-7)?;
+            let c = profile_crossing(profile, theta[j], chi2_min, limit, step, threshold, 1e-7)?;
             if let Some(t) = lower_found.into_inner() {
                 return Ok(ProfileOutcome::Lower(t));
             }

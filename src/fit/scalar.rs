@@ -7,7 +7,7 @@
 //! - [`profile_crossing`]: **solves** profile(t) = threshold between a minimum t_hat and a search
 //!   limit: steps out from t_hat, doubling, until the profile reaches the threshold, then Brent's
 //!   root finder (Brent 1973, ch. 4; argmin's `BrentRoot`) inside the bracket, with bisection as
-//!   the fallback when a re-minimised profile does not reproduce the sign change at the ends.
+//!   the fallback when Brent stops for any reason other than convergence.
 //!
 //! Every loop is capped; a NaN value, an exhausted cap or a solver that stopped for any reason
 //! other than convergence is reported in the result (`converged: false`, [`Crossing::Failed`]),
@@ -153,17 +153,34 @@ pub enum Crossing {
 }
 
 /// The point between `t_hat` and `limit` where `profile(t)` first reaches `threshold` (see the
-/// module doc). `profile(t_hat)` must be below `threshold`; trial points go out from `t_hat` by
-/// `step`, doubling.
+/// module doc). `v_hat = profile(t_hat)` (the minimum, known to the caller) must be below
+/// `threshold`; trial points go out from `t_hat` by `step`, then once to 5% beyond where the
+/// parabola through (t_hat, v_hat) and the first point reaches the threshold (at most twice the
+/// distance: a profile is close to a parabola near its minimum, so the bracket handed to Brent
+/// is tight), then doubling. No point is evaluated twice: the root
+/// finder starts from the bracket's values as the steps found them.
 pub fn profile_crossing(
-    mut profile: impl FnMut(f64) -> Result<f64>,
+    profile: impl FnMut(f64) -> Result<f64>,
     t_hat: f64,
+    v_hat: f64,
     limit: f64,
     step: f64,
     threshold: f64,
     tol: f64,
 ) -> Result<Crossing> {
-    if ![t_hat, limit, step, threshold, tol]
+    // Values already computed, by their exact argument (the bracket's ends are handed to the
+    // root finder as they are, so it finds them here).
+    let mut seen: Vec<(f64, f64)> = vec![(t_hat, v_hat)];
+    let mut profile = profile;
+    let mut profile = move |t: f64| -> Result<f64> {
+        if let Some(&(_, v)) = seen.iter().find(|p| p.0 == t) {
+            return Ok(v);
+        }
+        let v = profile(t)?;
+        seen.push((t, v));
+        Ok(v)
+    };
+    if ![t_hat, v_hat, limit, step, threshold, tol]
         .iter()
         .all(|x| x.is_finite())
         || !(tol > 0.0)
@@ -180,7 +197,7 @@ pub fn profile_crossing(
     let mut inner = t_hat;
     let mut dist = step.abs().max(tol);
     let mut outer = None;
-    for _ in 0..MAX_DOUBLINGS {
+    for k in 0..MAX_DOUBLINGS + 1 {
         let t = if (t_hat + dir * dist - limit) * dir >= 0.0 {
             limit
         } else {
@@ -198,7 +215,16 @@ pub fn profile_crossing(
             return Ok(Crossing::Open);
         }
         inner = t;
-        dist *= 2.0;
+        // After the first step, 5% beyond the parabola's crossing (see the doc): a factor above
+        // 1.05 (v is below the threshold) and at most 2; the one guided step comes on top of
+        // the doublings, so their reach is kept. NaN (v below v_hat: a lower minimum, which the
+        // caller handles) or inf (a flat start): doubling.
+        let ratio = ((threshold - v_hat) / (v - v_hat)).sqrt();
+        dist *= if k == 0 && ratio.is_finite() {
+            (1.05 * ratio).min(2.0)
+        } else {
+            2.0
+        };
     }
     let Some(outer) = outer else {
         return Ok(Crossing::Failed(format!(
@@ -241,9 +267,9 @@ pub fn profile_crossing(
             // Any other stop (the iteration cap): fall through to bisection.
         }
         (Err(_), None) => {
-            // No sign change at the ends on re-evaluation: a profile that re-minimises the other
-            // parameters need not return the same value twice (its inner minimisation may
-            // settle elsewhere). Bisection below trusts the classification of each new point.
+            // argmin refused the bracket (the ends' values are the steps' own, so their signs
+            // differ; kept as a fall-through all the same). Bisection below trusts the
+            // classification of each new point.
         }
     }
     let (mut below, mut above) = (inner, outer);
@@ -290,18 +316,52 @@ mod tests {
             Crossing::At(x) => x,
             other => panic!("{other:?}"),
         };
-        let up = at(profile_crossing(f, 2.0, 100.0, 0.5, 4.84, 1e-10).unwrap());
+        let up = at(profile_crossing(f, 2.0, 1.0, 100.0, 0.5, 4.84, 1e-10).unwrap());
         assert!((up - (2.0 + 3.84f64.sqrt())).abs() < 1e-9, "{up}");
-        let down = at(profile_crossing(f, 2.0, -100.0, 0.5, 4.84, 1e-10).unwrap());
+        let down = at(profile_crossing(f, 2.0, 1.0, -100.0, 0.5, 4.84, 1e-10).unwrap());
         assert!((down - (2.0 - 3.84f64.sqrt())).abs() < 1e-9, "{down}");
         // A plateau: never reaches the threshold before the limit.
         let flat = |x: f64| Ok(if x < 2.0 { (x - 2.0f64).powi(2) } else { 0.0 });
         assert_eq!(
-            profile_crossing(flat, 2.0, 50.0, 0.5, 3.84, 1e-10).unwrap(),
+            profile_crossing(flat, 2.0, 0.0, 50.0, 0.5, 3.84, 1e-10).unwrap(),
             Crossing::Open
         );
-        let down = at(profile_crossing(flat, 2.0, -50.0, 0.5, 3.84, 1e-10).unwrap());
+        let down = at(profile_crossing(flat, 2.0, 0.0, -50.0, 0.5, 3.84, 1e-10).unwrap());
         assert!((down - (2.0 - 3.84f64.sqrt())).abs() < 1e-9, "{down}");
+    }
+
+    #[test]
+    fn a_crossing_evaluates_no_point_twice() {
+        // A skewed profile, (x - 2)^2 (1 - 0.1 (x - 2)) + 1, whose upper crossing of 1 + 3.84 lies
+        // at 2 + r with r^2 - 0.1 r^3 = 3.84 (r = 2.22...); the first step, 0.9 sqrt(3.84), falls
+        // short, the parabola's step brackets the root. The old doubling re-evaluated both ends
+        // of the bracket in Brent's start: every argument here is new, and the minimum's value
+        // is never asked for.
+        let mut calls: Vec<f64> = Vec::new();
+        let f = |x: f64| {
+            calls.push(x);
+            let d = x - 2.0;
+            Ok(d * d * (1.0 - 0.1 * d) + 1.0)
+        };
+        let step = 0.9 * 3.84f64.sqrt();
+        let c = profile_crossing(f, 2.0, 1.0, 100.0, step, 4.84, 1e-10).unwrap();
+        // The root by Newton's method in the test (independent of the code under test).
+        let mut r = 2.2f64;
+        for _ in 0..50 {
+            r -= (r * r - 0.1 * r * r * r - 3.84) / (2.0 * r - 0.3 * r * r);
+        }
+        assert!(
+            matches!(c, Crossing::At(x) if (x - (2.0 + r)).abs() < 1e-9),
+            "{c:?} {r}"
+        );
+        assert!(!calls.contains(&2.0), "{calls:?}");
+        for (k, x) in calls.iter().enumerate() {
+            assert!(!calls[..k].contains(x), "{x} evaluated twice: {calls:?}");
+        }
+        // The parabola's step lands just beyond the root (within 5%: the skew's error plus the
+        // 5% margin); doubling alone put it at 2 x 1.76, 59% beyond.
+        let second = calls[1] - 2.0;
+        assert!(second > r && second < 1.05 * r, "{calls:?} {r}");
     }
 
     #[test]
@@ -310,12 +370,12 @@ mod tests {
         // on a NaN start).
         let f = |x: f64| Ok((x - 2.0f64).powi(2));
         assert!(matches!(
-            profile_crossing(f, f64::NAN, 10.0, 0.5, 3.84, 1e-10).unwrap(),
+            profile_crossing(f, f64::NAN, 0.0, 10.0, 0.5, 3.84, 1e-10).unwrap(),
             Crossing::Failed(_)
         ));
         let nan_beyond = |x: f64| Ok(if x > 3.0 { f64::NAN } else { 0.0 });
         assert!(matches!(
-            profile_crossing(nan_beyond, 2.0, 10.0, 0.5, 3.84, 1e-10).unwrap(),
+            profile_crossing(nan_beyond, 2.0, 0.0, 10.0, 0.5, 3.84, 1e-10).unwrap(),
             Crossing::Failed(_)
         ));
         let m = brent_minimize(|x| Ok(if x > 1.0 { f64::NAN } else { x }), 0.0, 3.0, 1e-9).unwrap();
@@ -328,7 +388,7 @@ mod tests {
                 expected: "y",
             })
         };
-        assert!(profile_crossing(err, 2.0, 10.0, 0.5, 3.84, 1e-10).is_err());
+        assert!(profile_crossing(err, 2.0, 0.0, 10.0, 0.5, 3.84, 1e-10).is_err());
         // A profile that gives different values at the same point (re-minimisation settling
         // elsewhere) still ends, by bisection: a step function with a threshold at 3.
         let mut calls = 0;
@@ -336,7 +396,7 @@ mod tests {
             calls += 1;
             Ok(if x >= 3.0 { 10.0 } else { (calls % 2) as f64 })
         };
-        let c = profile_crossing(flaky, 2.0, 10.0, 0.5, 5.0, 1e-10).unwrap();
+        let c = profile_crossing(flaky, 2.0, 0.0, 10.0, 0.5, 5.0, 1e-10).unwrap();
         assert!(
             matches!(c, Crossing::At(x) if (x - 3.0).abs() < 1e-9),
             "{c:?}"
