@@ -31,6 +31,7 @@
 #[cfg(feature = "io")]
 pub mod bench;
 pub mod contact;
+pub mod cpu;
 #[cfg(feature = "io")]
 pub mod data;
 pub mod dem;

@@ -104,3 +104,34 @@ fn many_distinct_points_give_the_certified_optimum_of_the_point_order_sums() {
         }
     }
 }
+
+/// The same fits with the hot loops on the baseline code and on AVX2 and FMA
+/// (`restitution::cpu`): the same numbers to the last bit, and the same work. (On a processor
+/// without AVX2 and FMA both runs take the baseline code and the comparison is void; it says so.)
+#[test]
+fn the_wide_registers_change_no_bit() {
+    let data = data();
+    if !restitution::cpu::uses_avx2_fma() {
+        eprintln!("this processor has no AVX2 and FMA: both runs take the baseline code");
+    }
+    for kind in [ModelKind::Min, ModelKind::Product, ModelKind::PowerLaw] {
+        let run = |baseline: bool| {
+            restitution::cpu::set_baseline_only(baseline);
+            let r = fit(&data, kind, &FitOptions::default()).unwrap();
+            restitution::cpu::set_baseline_only(false);
+            let bits = |x: f64| x.to_bits();
+            let mut v: Vec<u64> = vec![bits(r.chi2), r.evaluations, r.profile_evaluations];
+            for p in &r.params {
+                v.push(bits(p.best_fit));
+                v.push(bits(p.stderr_abs.unwrap_or(f64::NAN)));
+                v.push(bits(p.ci95.0.unwrap_or(f64::NAN)));
+                v.push(bits(p.ci95.1.unwrap_or(f64::NAN)));
+            }
+            v.push(bits(r.global.gap_chi2));
+            v.push(r.global.cells);
+            v.extend(r.predicted.iter().map(|x| bits(*x)));
+            v
+        };
+        assert_eq!(run(true), run(false), "{kind}");
+    }
+}

@@ -291,7 +291,9 @@ impl<'a> Evaluator<'a> {
         plastic::e_of_u(self.data.obs[i].v_n_m_s / self.v_yield_m_s(i, sigma_y_pa))
     }
 
-    /// e_pm of point `i` given sigma_y^(5/2) (computed once for all points).
+    /// e_pm of point `i` given sigma_y^(5/2) (computed once for all points; inlined into the
+    /// evaluations' loops, which [`crate::cpu::fast`] compiles for FMA where there is one).
+    #[inline(always)]
     fn e_pm_s25(&self, i: usize, s25: f64) -> f64 {
         plastic::e_of_u(self.data.obs[i].v_n_m_s / (self.v_yield_per_pa[i] * s25))
     }
@@ -412,7 +414,7 @@ impl<'a> Evaluator<'a> {
         let results: Vec<Result<()>> = out[..n]
             .par_chunks_mut(size)
             .enumerate()
-            .map(|(c, slots)| chunk(c * size, slots))
+            .map(|(c, slots)| crate::cpu::fast(|| chunk(c * size, slots)))
             .collect();
         results.into_iter().collect()
     }

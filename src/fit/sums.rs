@@ -32,7 +32,7 @@ pub fn sum<const K: usize>(n: usize, part: impl Fn(Range<usize>) -> [f64; K] + S
     }
     let parts: Vec<[f64; K]> = (0..n.div_ceil(CHUNK))
         .into_par_iter()
-        .map(|c| part(c * CHUNK..((c + 1) * CHUNK).min(n)))
+        .map(|c| crate::cpu::fast(|| part(c * CHUNK..((c + 1) * CHUNK).min(n))))
         .collect();
     let mut s = [0.0; K];
     for p in parts {
@@ -53,9 +53,11 @@ pub fn fill(out: &mut [f64], f: impl Fn(usize) -> f64 + Sync) {
         return;
     }
     out.par_chunks_mut(CHUNK).enumerate().for_each(|(c, o)| {
-        for (j, x) in o.iter_mut().enumerate() {
-            *x = f(c * CHUNK + j);
-        }
+        crate::cpu::fast(|| {
+            for (j, x) in o.iter_mut().enumerate() {
+                *x = f(c * CHUNK + j);
+            }
+        })
     });
 }
 
@@ -69,7 +71,7 @@ pub fn fill_chunks(out: &mut [f64], f: impl Fn(usize, &mut [f64]) + Sync) {
     }
     out.par_chunks_mut(CHUNK)
         .enumerate()
-        .for_each(|(c, o)| f(c * CHUNK, o));
+        .for_each(|(c, o)| crate::cpu::fast(|| f(c * CHUNK, o)));
 }
 
 #[cfg(test)]

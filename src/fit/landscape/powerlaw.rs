@@ -374,7 +374,9 @@ impl PowerLaw {
             .zip(o2[..n].par_chunks_mut(sums::CHUNK))
             .zip(o3[..n].par_chunks_mut(sums::CHUNK))
             .enumerate()
-            .map(|(c, (((p0, p1), p2), p3))| chunk(c * sums::CHUNK, [p0, p1, p2, p3]))
+            .map(|(c, (((p0, p1), p2), p3))| {
+                crate::cpu::fast(|| chunk(c * sums::CHUNK, [p0, p1, p2, p3]))
+            })
             .collect();
         parts.iter().sum()
     }

@@ -104,13 +104,13 @@ impl Evaluator<'_> {
         let results: Vec<Result<()>> = if c1.is_empty() {
             c0.par_chunks_mut(size)
                 .enumerate()
-                .map(|(c, a)| chunk(c * size, a, &mut []))
+                .map(|(c, a)| crate::cpu::fast(|| chunk(c * size, a, &mut [])))
                 .collect()
         } else {
             c0.par_chunks_mut(size)
                 .zip(c1.par_chunks_mut(size))
                 .enumerate()
-                .map(|(c, (a, b))| chunk(c * size, a, b))
+                .map(|(c, (a, b))| crate::cpu::fast(|| chunk(c * size, a, b)))
                 .collect()
         };
         results.into_iter().collect()
