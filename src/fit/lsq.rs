@@ -58,6 +58,20 @@ pub trait Residuals {
     ) -> Option<Result<()>> {
         None
     }
+    /// The residuals into `out` and, in the same pass, the exact Jacobian at the same `theta`
+    /// into `jac` (as [`Residuals::jacobian_exact`] gives it, to the last bit), where together
+    /// they cost little more than the residuals alone: Levenberg-Marquardt asks for this at
+    /// trial points, where it needs the Jacobian whenever it accepts the step. `None` (the
+    /// default): nothing was written, [`Residuals::residuals`] serves.
+    fn residuals_and_jacobian(
+        &self,
+        _theta: &[f64],
+        _out: &mut [f64],
+        _free: &[bool],
+        _jac: &mut DMatrix<f64>,
+    ) -> Option<Result<()>> {
+        None
+    }
 }
 
 fn nan_residual(theta: &[f64]) -> Error {
@@ -234,6 +248,10 @@ pub fn levenberg_marquardt(
     let mut nu = 2.0;
     let mut f_new = vec![0.0; n];
     let mut need_jac = true;
+    // The Jacobian at the last trial point, when the problem gave it with the residuals.
+    let n_free = free.iter().filter(|&&b| b).count();
+    let mut jac_trial = DMatrix::zeros(0, 0);
+    let mut jac_next: Option<DMatrix<f64>> = None;
     // J^T J over the parameters free for the step (computed once per Jacobian).
     let mut a = DMatrix::zeros(0, 0);
     let mut free_now: Vec<bool> = free.to_vec();
@@ -241,7 +259,10 @@ pub fn levenberg_marquardt(
     for it in 1..=opts.max_iterations {
         if need_jac {
             // Active set: a parameter on a bound whose descent direction leaves the box is held.
-            let all = jacobian(p, &theta, free, &f)?;
+            let all = match jac_next.take() {
+                Some(j) => j,
+                None => jacobian(p, &theta, free, &f)?,
+            };
             if all.iter().any(|x| !x.is_finite()) {
                 return Ok(outcome(theta, chi2v, it, false, "Jacobian not finite"));
             }
@@ -313,7 +334,29 @@ pub fn levenberg_marquardt(
             .all(|&j| (trial[j] - theta[j]).abs() <= opts.xtol * (theta[j].abs() + opts.xtol));
         // Predicted decrease of chi2 for the (projected) step, from the Gauss-Newton model.
         let pred = -(2.0 * g.dot(&step) + (&a * &step).dot(&step));
-        residuals_checked(p, &trial, &mut f_new)?;
+        jac_trial.resize_mut(n, n_free, 0.0);
+        jac_trial.fill(0.0);
+        // A step that will end the iteration if it is accepted (too small, or too little
+        // decrease predicted) needs no Jacobian after it.
+        let last = small_step || pred <= opts.ftol * chi2v;
+        let spec = if last {
+            None
+        } else {
+            p.residuals_and_jacobian(&trial, &mut f_new, free, &mut jac_trial)
+        };
+        let with_jac = match spec {
+            Some(done) => {
+                done?;
+                if f_new.iter().any(|x| x.is_nan()) {
+                    return Err(nan_residual(&trial));
+                }
+                true
+            }
+            None => {
+                residuals_checked(p, &trial, &mut f_new)?;
+                false
+            }
+        };
         let chi2_new: f64 = f_new.iter().map(|x| x * x).sum();
         let actual = chi2v - chi2_new;
         if chi2_new.is_finite() && actual > 0.0 && pred > 0.0 {
@@ -325,6 +368,9 @@ pub fn levenberg_marquardt(
             mu *= (1.0f64 / 3.0).max(1.0 - (2.0 * rho - 1.0).powi(3));
             nu = 2.0;
             need_jac = true;
+            if with_jac {
+                jac_next = Some(std::mem::replace(&mut jac_trial, DMatrix::zeros(0, 0)));
+            }
             if done || small_step {
                 return Ok(outcome(
                     theta,

@@ -107,6 +107,28 @@ impl Residuals for Objective<'_> {
             _ => None,
         }
     }
+    fn residuals_and_jacobian(
+        &self,
+        theta: &[f64],
+        out: &mut [f64],
+        free: &[bool],
+        jac: &mut DMatrix<f64>,
+    ) -> Option<Result<()>> {
+        let k = self.kind;
+        if k == ModelKind::PowerLaw || !self.ev.has_exact_jacobian(k) || !free.contains(&true) {
+            return None;
+        }
+        self.evals.set(self.evals.get() + 1);
+        let p = k.to_physical(theta);
+        Some(self.ev.jacobian_separable_with(
+            k,
+            &p,
+            &self.inv_sigma,
+            free,
+            jac,
+            Some((&self.e, out)),
+        ))
+    }
 }
 
 impl<'a> Objective<'a> {
