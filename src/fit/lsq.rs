@@ -252,6 +252,7 @@ pub fn levenberg_marquardt(
     let n_free = free.iter().filter(|&&b| b).count();
     let mut jac_trial = DMatrix::zeros(0, 0);
     let mut jac_next: Option<DMatrix<f64>> = None;
+    let mut fuses = true;
     // J^T J over the parameters free for the step (computed once per Jacobian).
     let mut a = DMatrix::zeros(0, 0);
     let mut free_now: Vec<bool> = free.to_vec();
@@ -334,15 +335,18 @@ pub fn levenberg_marquardt(
             .all(|&j| (trial[j] - theta[j]).abs() <= opts.xtol * (theta[j].abs() + opts.xtol));
         // Predicted decrease of chi2 for the (projected) step, from the Gauss-Newton model.
         let pred = -(2.0 * g.dot(&step) + (&a * &step).dot(&step));
-        jac_trial.resize_mut(n, n_free, 0.0);
-        jac_trial.fill(0.0);
         // A step that will end the iteration if it is accepted (too small, or too little
-        // decrease predicted) needs no Jacobian after it.
+        // decrease predicted) needs no Jacobian after it; a problem that declined once is not
+        // asked again (nor is a matrix prepared for it).
         let last = small_step || pred <= opts.ftol * chi2v;
-        let spec = if last {
+        let spec = if last || !fuses {
             None
         } else {
-            p.residuals_and_jacobian(&trial, &mut f_new, free, &mut jac_trial)
+            jac_trial.resize_mut(n, n_free, 0.0);
+            jac_trial.fill(0.0);
+            let spec = p.residuals_and_jacobian(&trial, &mut f_new, free, &mut jac_trial);
+            fuses = spec.is_some();
+            spec
         };
         let with_jac = match spec {
             Some(done) => {
