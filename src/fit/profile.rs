@@ -6,7 +6,8 @@
 //! model linear in its parameters the interval is value +- 1.96 stderr). Reference: Venzon &
 //! Moolgavkar, Applied Statistics 37, 87 (1988); the PDG's "Statistics" review, section 40.3.2.
 //!
-//! **Method**: from the minimum, steps of about one standard error outwards, doubling, until the
+//! **Method**: from the minimum, a step of about 1.96 standard errors outwards, then one to just
+//! beyond where the parabola through the minimum and that point crosses, then doubling, until the
 //! profile passes the threshold or the search box ends (an open side: the parameter is a bound);
 //! then the crossing by Brent's root finder ([`super::scalar::profile_crossing`]). The inner
 //! minimisation is Levenberg-Marquardt warm-started from the nearest profile point already

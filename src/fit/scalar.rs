@@ -5,15 +5,17 @@
 //!   parabolic steps; Brent, "Algorithms for Minimization without Derivatives", 1973, ch. 5;
 //!   argmin's `BrentOpt`). **Needs** a bracket holding the minimum wanted (it finds a local one).
 //! - [`profile_crossing`]: **solves** profile(t) = threshold between a minimum t_hat and a search
-//!   limit: steps out from t_hat, doubling, until the profile reaches the threshold, then Brent's
-//!   root finder (Brent 1973, ch. 4; argmin's `BrentRoot`) inside the bracket, with bisection as
-//!   the fallback when Brent stops for any reason other than convergence.
+//!   limit: steps out from t_hat (the second step to just beyond the parabola's crossing, then
+//!   doubling) until the profile reaches the threshold, then Brent's root finder (Brent 1973,
+//!   ch. 4; argmin's `BrentRoot`) inside the bracket, from the values the steps found, with
+//!   bisection as the fallback when Brent stops for any reason other than convergence.
 //!
 //! Every loop is capped; a NaN value, an exhausted cap or a solver that stopped for any reason
 //! other than convergence is reported in the result (`converged: false`, [`Crossing::Failed`]),
 //! never passed on as a number. An `Err` raised by the function itself is returned as it is.
 //!
-//! **Known answers** (tests below): a parabola's minimum and its crossings at 2 +- sqrt(3.84).
+//! **Known answers** (tests below): a parabola's minimum and its crossings at 2 +- sqrt(3.84); a
+//! skewed profile's crossing, found with no point evaluated twice.
 
 use crate::error::{Error, Result};
 use argmin::core::{CostFunction, Executor, State, TerminationReason};
