@@ -171,6 +171,23 @@ mod tests {
     /// (residuals of both signs), a pair, unequal spheres and a wall, speeds on both sides of
     /// yield at the parameters tried, for every model, both contact rules and every set of free
     /// parameters the fits use (all; one held, as in the profiles).
+    const SEPARABLE: [ModelKind; 4] = [
+        ModelKind::Vm,
+        ModelKind::Pm,
+        ModelKind::Min,
+        ModelKind::Product,
+    ];
+
+    /// The sets of free parameters the fits use: all, and (two parameters) each one held, as in
+    /// the profiles.
+    fn free_sets(k: usize) -> Vec<Vec<bool>> {
+        if k == 1 {
+            vec![vec![true]]
+        } else {
+            vec![vec![true, true], vec![false, true], vec![true, false]]
+        }
+    }
+
     /// The residuals and Jacobian of one pass (Levenberg-Marquardt's trial points) are those of
     /// the two separate computations to the last bit, on small data and on data large enough
     /// for the chunked parallel path (20 000 points, every speed distinct), for every separable
@@ -191,22 +208,13 @@ mod tests {
             let data = FitData::new(m, obs).unwrap();
             for rule in ContactEnd::ALL {
                 let ev = Evaluator::new(&data, rule, VmMethod::Master);
-                for kind in [
-                    ModelKind::Vm,
-                    ModelKind::Pm,
-                    ModelKind::Min,
-                    ModelKind::Product,
-                ] {
+                for kind in SEPARABLE {
                     let obj = Objective::new(&ev, kind).unwrap();
                     let k = kind.n_params();
                     let theta: Vec<f64> = (0..k)
                         .map(|j| 0.4 * obj.lower[j] + 0.6 * obj.upper[j])
                         .collect();
-                    let frees: Vec<Vec<bool>> = if k == 1 {
-                        vec![vec![true]]
-                    } else {
-                        vec![vec![true, true], vec![false, true], vec![true, false]]
-                    };
+                    let frees = free_sets(k);
                     let mut f0 = vec![0.0; n];
                     lsq::residuals_checked(&obj, &theta, &mut f0).unwrap();
                     for free in &frees {
@@ -262,12 +270,7 @@ mod tests {
         let mut checked = 0;
         for rule in ContactEnd::ALL {
             let ev = Evaluator::new(&data, rule, VmMethod::Master);
-            for kind in [
-                ModelKind::Vm,
-                ModelKind::Pm,
-                ModelKind::Min,
-                ModelKind::Product,
-            ] {
+            for kind in SEPARABLE {
                 let obj = Objective::new(&ev, kind).unwrap();
                 let k = kind.n_params();
                 let mid: Vec<f64> = (0..k)
@@ -276,11 +279,7 @@ mod tests {
                 let near_lo: Vec<f64> = (0..k)
                     .map(|j| 0.8 * obj.lower[j] + 0.2 * obj.upper[j])
                     .collect();
-                let frees: Vec<Vec<bool>> = if k == 1 {
-                    vec![vec![true]]
-                } else {
-                    vec![vec![true, true], vec![false, true], vec![true, false]]
-                };
+                let frees = free_sets(k);
                 for theta in [mid, near_lo] {
                     let mut f0 = vec![0.0; ev.len()];
                     lsq::residuals_checked(&obj, &theta, &mut f0).unwrap();

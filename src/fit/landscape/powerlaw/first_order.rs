@@ -16,12 +16,7 @@ impl PowerLaw {
         let (a, zero) = (f64x4::splat(a), f64x4::ZERO);
         let [f, d, h] = sums::sum(self.n, |points| {
             let r = points;
-            let (y, w, zlo, zhi) = (
-                &y[r.clone()],
-                &w[r.clone()],
-                &zlo[r.clone()],
-                &zhi[r.clone()],
-            );
+            let [y, w, zlo, zhi] = lanes::slices(&r, [y, w, zlo, zhi]);
             let (mut f, mut d, mut h) = (zero, zero, zero);
             for b in (0..r.len()).step_by(lanes::LANES) {
                 let (y, w, zlo, zhi) = (load(y, b), load(w, b), load(zlo, b), load(zhi, b));
@@ -51,12 +46,7 @@ impl PowerLaw {
         let half = f64x4::splat(0.5);
         let [num, den] = sums::sum(self.n, |points| {
             let r = points;
-            let (y, w, zlo, zhi) = (
-                &y[r.clone()],
-                &w[r.clone()],
-                &zlo[r.clone()],
-                &zhi[r.clone()],
-            );
+            let [y, w, zlo, zhi] = lanes::slices(&r, [y, w, zlo, zhi]);
             let (mut num, mut den) = (f64x4::ZERO, f64x4::ZERO);
             for b in (0..r.len()).step_by(lanes::LANES) {
                 let z = half * (load(zlo, b) + load(zhi, b));

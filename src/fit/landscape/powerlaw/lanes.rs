@@ -15,6 +15,15 @@ use wide::f64x4;
 /// Points per group.
 pub(super) const LANES: usize = 4;
 
+/// The part `r` of each of the point arrays `s` (a chunk of a sum over the points).
+#[inline(always)]
+pub(super) fn slices<'a, const K: usize>(
+    r: &std::ops::Range<usize>,
+    s: [&'a [f64]; K],
+) -> [&'a [f64]; K] {
+    s.map(|v| &v[r.clone()])
+}
+
 /// `s[b..b + 4]` as one group, zeros past the end of `s`.
 #[inline(always)]
 pub(super) fn load(s: &[f64], b: usize) -> f64x4 {

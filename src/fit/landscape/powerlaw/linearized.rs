@@ -123,18 +123,8 @@ fn pass(c: &Cell, x: [f64; 3], at: [f64; 2]) -> Pass {
     // the lower end is above y; v < 0: the upper end is below it; u <= v, so at most one).
     let s = sums::sum::<SUMS>(n, |points| {
         let r = points;
-        let (y, w, c1, c2) = (
-            &c.y[r.clone()],
-            &c.w[r.clone()],
-            &c.c1[r.clone()],
-            &c.c2[r.clone()],
-        );
-        let (zc, zhi, zlo, rz) = (
-            &c.zc[r.clone()],
-            &c.zhi[r.clone()],
-            &c.zlo[r.clone()],
-            &c.rz[r.clone()],
-        );
+        let [y, w, c1, c2] = lanes::slices(&r, [c.y, c.w, c.c1, c.c2]);
+        let [zc, zhi, zlo, rz] = lanes::slices(&r, [c.zc, c.zhi, c.zlo, c.rz]);
         let mut s = [zero; SUMS];
         for b in (0..r.len()).step_by(lanes::LANES) {
             let (y, w, c1, c2) = (load(y, b), load(w, b), load(c1, b), load(c2, b));
