@@ -16,7 +16,9 @@
 use super::{Evaluator, ModelKind};
 use crate::error::{Error, Result};
 use crate::models::plastic;
-use crate::models::viscoelastic::{VmMethod, master};
+use crate::models::viscoelastic::VmMethod;
+#[cfg(doc)]
+use crate::models::viscoelastic::master;
 use nalgebra::DMatrix;
 
 impl Evaluator<'_> {
@@ -85,11 +87,7 @@ impl Evaluator<'_> {
             let m = c0.len();
             let (mut ev, mut sv) = (vec![1.0; m], vec![0.0; m]);
             if kind != ModelKind::Pm {
-                for (j, k) in ev.iter_mut().enumerate() {
-                    *k = self.kappa(start + j, eta);
-                }
-                master::e_and_slope_master_in_place(&mut ev, &mut sv, self.rule)
-                    .map_err(|j| self.master_refusal(start + j, eta))?;
+                self.vm_in_kappa_order(start, eta, &mut ev, Some(&mut sv))?;
             }
             for j in 0..m {
                 let i = start + j;
