@@ -185,17 +185,6 @@ fn terms<const MIN: bool, const FIRST: bool, const SECOND: bool>(
     t
 }
 
-/// Adds point `p`'s terms at x to `s`.
-#[inline(always)]
-pub(super) fn add<const MIN: bool, const FIRST: bool, const SECOND: bool>(
-    cell: &Cell,
-    x: [f64; 2],
-    p: Point,
-    s: &mut Terms,
-) {
-    s.add(terms::<MIN, FIRST, SECOND>(cell, x, p));
-}
-
 impl Terms {
     #[inline(always)]
     fn add(&mut self, t: [f64; 9]) {

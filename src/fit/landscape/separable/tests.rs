@@ -214,10 +214,21 @@ fn newton_steps_stay_in_the_cell_and_stop_without_curvature() {
 }
 
 /// A pass's sums as the per-point terms were first written (branches, `Cell::enclosure` and
-/// `pick`), over points `range` in order: the reference for `kernel.rs`.
+/// `pick`), over every point in order: the reference for `kernel.rs`.
 fn reference_terms(l: &Separable, cell: &Cell, x: [f64; 2], first: bool) -> kernel::Terms {
+    reference_terms_of(l, cell, x, first, 0..l.n)
+}
+
+/// [`reference_terms`] over `points`, in their order.
+fn reference_terms_of(
+    l: &Separable,
+    cell: &Cell,
+    x: [f64; 2],
+    first: bool,
+    points: impl Iterator<Item = usize>,
+) -> kernel::Terms {
     let mut s = kernel::Terms::default();
-    for i in 0..l.n {
+    for i in points {
         let (ei, wi) = (l.e[i], l.w[i]);
         if first {
             let d = cell.first_order_gap(i, ei);
@@ -250,6 +261,57 @@ fn reference_terms(l: &Separable, cell: &Cell, x: [f64; 2], first: bool) -> kern
         s.h[2] += w2 * (grad[1] * grad[1] + 2.0 * d * enc.r2[1]);
     }
     s
+}
+
+#[test]
+fn a_sample_sums_every_thirteenth_point_of_each_chunk_bit_for_bit() {
+    // The sampled pass of large data runs over its own contiguous copy of the points: its
+    // sums must be those of every LOOSE_STRIDE-th point of each chunk of the full data, taken
+    // in place, each chunk in point order and the chunks in order (no tolerance).
+    let d = data(sums::PARALLEL_MIN_POINTS + 1000, true);
+    let ev = Evaluator::new(&d, ContactEnd::Overlap, VmMethod::Master);
+    let mut compared = 0;
+    for kind in KINDS {
+        let obj = Objective::new(&ev, kind).unwrap();
+        for (lo, hi) in cells().into_iter().step_by(3) {
+            let l = cell_landscape(&obj, lo, hi);
+            let cell = l.cell([0, 0], [1, 1]);
+            for x in [[0.5, 0.5], [0.17, 0.83]] {
+                let got = l.pass(&l.sample_cell([0, 0], [1, 1]), x, true, true);
+                let mut want = [0.0; 9];
+                for c in 0..l.n.div_ceil(sums::CHUNK) {
+                    let points =
+                        (c * sums::CHUNK..((c + 1) * sums::CHUNK).min(l.n)).step_by(LOOSE_STRIDE);
+                    let t = reference_terms_of(&l, &cell, x, true, points);
+                    let t = [
+                        t.first, t.phi, t.g[0], t.g[1], t.g_abs[0], t.g_abs[1], t.h[0], t.h[1],
+                        t.h[2],
+                    ];
+                    for (w, t) in want.iter_mut().zip(t) {
+                        *w += t;
+                    }
+                }
+                let got = [
+                    got.first,
+                    got.phi,
+                    got.g[0],
+                    got.g[1],
+                    got.g_abs[0],
+                    got.g_abs[1],
+                    got.h[0],
+                    got.h[1],
+                    got.h[2],
+                ];
+                assert_eq!(
+                    got.map(f64::to_bits),
+                    want.map(f64::to_bits),
+                    "{kind} {lo:?} {hi:?} {x:?}"
+                );
+                compared += usize::from(want[1] > 0.0);
+            }
+        }
+    }
+    assert!(compared > 10, "{compared} cases with phi > 0");
 }
 
 #[test]
