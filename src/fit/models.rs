@@ -232,6 +232,8 @@ pub struct Evaluator<'a> {
     /// offsets in the block in increasing order of kappa per unit eta (empty unless the master
     /// curve evaluates e_vm): see [`Evaluator::with_kappas_in_order`].
     kappa_order: Vec<u32>,
+    /// kappa per unit eta in that order (read in sequence, not gathered).
+    kappa_per_eta_in_order: Vec<f64>,
 }
 
 impl<'a> Evaluator<'a> {
@@ -258,6 +260,7 @@ impl<'a> Evaluator<'a> {
                 .map(|o| (o.v_n_m_s / POWERLAW_V_REF_M_S).ln())
                 .collect(),
             kappa_order: Vec::new(),
+            kappa_per_eta_in_order: Vec::new(),
         };
         if method == VmMethod::Master {
             let kpe = &ev.kappa_per_eta;
@@ -272,6 +275,9 @@ impl<'a> Evaluator<'a> {
                 });
                 debug_assert_eq!(at, b * sums::CHUNK);
             }
+            ev.kappa_per_eta_in_order = (ev.kappa_order.iter().enumerate())
+                .map(|(i, &j)| kpe[i / sums::CHUNK * sums::CHUNK + j as usize])
+                .collect();
         }
         ev
     }
@@ -366,8 +372,12 @@ impl<'a> Evaluator<'a> {
             let m = block.len();
             let order = &self.kappa_order[base..base + m];
             let (k, sk) = (&mut k[..m], &mut sk[..m]);
-            for (k, &j) in k.iter_mut().zip(order) {
-                *k = self.kappa(base + j as usize, eta);
+            // kappa(i, eta) of the points in order.
+            for (k, c) in k
+                .iter_mut()
+                .zip(&self.kappa_per_eta_in_order[base..base + m])
+            {
+                *k = c * eta;
             }
             let done = match slopes {
                 Some(_) => master::e_and_slope_master_in_place(k, sk, self.rule),
