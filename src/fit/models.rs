@@ -366,22 +366,19 @@ impl<'a> Evaluator<'a> {
         mut slopes: Option<&mut [f64]>,
     ) -> Result<()> {
         debug_assert_eq!(start % sums::CHUNK, 0, "blocks start at multiples of CHUNK");
-        let (mut k, mut sk) = ([0.0; sums::CHUNK], [0.0; sums::CHUNK]);
         for (b, block) in values.chunks_mut(sums::CHUNK).enumerate() {
             let base = start + b * sums::CHUNK;
             let m = block.len();
             let order = &self.kappa_order[base..base + m];
-            let (k, sk) = (&mut k[..m], &mut sk[..m]);
-            // kappa(i, eta) of the points in order.
-            for (k, c) in k
-                .iter_mut()
-                .zip(&self.kappa_per_eta_in_order[base..base + m])
-            {
-                *k = c * eta;
-            }
+            // kappa(i, eta) of the points in order (buffers of the block's size: zeroing a
+            // whole chunk's would cost small data more than their evaluation).
+            let mut k: Vec<f64> = (self.kappa_per_eta_in_order[base..base + m].iter())
+                .map(|c| c * eta)
+                .collect();
+            let mut sk = vec![0.0; if slopes.is_some() { m } else { 0 }];
             let done = match slopes {
-                Some(_) => master::e_and_slope_master_in_place(k, sk, self.rule),
-                None => master::e_master_in_place(k, self.rule),
+                Some(_) => master::e_and_slope_master_in_place(&mut k, &mut sk, self.rule),
+                None => master::e_master_in_place(&mut k, self.rule),
             };
             if let Err(pos) = done {
                 let first = (0..m)
