@@ -35,7 +35,11 @@ pub fn uses_avx2_fma() -> bool {
 
 /// `f()`, compiled with AVX2 and FMA when [`uses_avx2_fma`] (`f` is a closure called once from
 /// the wrapper, so it is inlined there and its body is compiled for the wider registers; what it
-/// calls without inlining keeps the baseline code).
+/// calls without inlining keeps the baseline code). A body the compiler will not inline (too
+/// large, or a closure called from several places) runs as baseline code, which a profile shows
+/// outside `avx2_fma`: such a body gets its own `#[target_feature]` copy behind
+/// [`uses_avx2_fma`], as the master curve's evaluations have
+/// ([`crate::models::viscoelastic::master::e_master_in_place`]).
 #[inline]
 pub fn fast<R>(f: impl FnOnce() -> R) -> R {
     #[cfg(target_arch = "x86_64")]
