@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# CPU time (user + system) of two builds of `fit` on 100 000 distinct rows (the data of
-# scripts/time_big_fit.sh), run alternately so that both see the same load; prints the median
-# and the least of each and the ratio of the medians. Quoted in the README (known limitations).
+# CPU time (user + system) of two builds of `fit` on 100 000 distinct rows (written by
+# scripts/big_fit_data.py, as for scripts/time_big_fit.sh), run alternately so that both see the
+# same load; prints the median and the least of each and the ratio of the medians. Quoted in
+# the README (known limitations).
 #
 # Usage: bash scripts/compare_big_fit.sh OLD_BINARY NEW_BINARY [MODEL] [ROUNDS]
 #        (MODEL: vm, pm, min, product or powerlaw, default product; ROUNDS default 6)
@@ -13,19 +14,7 @@ model=${3:-product}
 rounds=${4:-6}
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
-python3 - "$dir" <<'PY'
-import random, sys
-d = sys.argv[1]
-lines = [l for l in open("data/fig7_nylon.csv") if not l.startswith("#") and l.strip()]
-head, rows = lines[0], lines[1:]
-random.seed(1)
-with open(f"{d}/distinct.csv", "w") as b:
-    b.write(head)
-    for i in range(100_000):
-        f = rows[i % len(rows)].rstrip("\n").split(",")
-        f[1] = repr(float(f[1]) * (1 + random.uniform(-1e-3, 1e-3)))
-        b.write(",".join(f) + "\n")
-PY
+python3 scripts/big_fit_data.py "$dir"
 for i in $(seq "$rounds"); do
     for b in old new; do
         bin=$old
@@ -39,4 +28,8 @@ median() { sort -n "$1" | awk '{a[NR] = $1} END {print a[int((NR + 1) / 2)]}'; }
 least() { sort -n "$1" | head -1; }
 mo=$(median "$dir/old")
 mn=$(median "$dir/new")
-echo "$model, $rounds alternate runs, CPU s (user + system): old median $mo (least $(least "$dir/old")), new median $mn (least $(least "$dir/new")), ratio $(awk -v a="$mn" -v b="$mo" 'BEGIN {printf "%.2f", a / b}')"
+lo=$(least "$dir/old")
+ln=$(least "$dir/new")
+ratio=$(awk -v a="$mn" -v b="$mo" 'BEGIN {printf "%.2f", a / b}')
+echo "$model, $rounds alternate runs, CPU s (user + system): old median $mo (least $lo)," \
+    "new median $mn (least $ln), ratio $ratio"

@@ -1,16 +1,17 @@
 #!/usr/bin/env bash
 # CPU and wall time of `fit` on 100 000 rows, per model: the Fig. 7 data repeated (rows that
 # share a pair geometry and a speed, merged exactly by the fit), and the same rows with every
-# speed moved by up to 0.1% (100 000 distinct points: the certified search's cost grows with
-# them; above 16384 points its sums run on both cores, so wall time depends on the machine's
-# load). Quoted in the README (fuzzing; known limitations). With the first-order cell bounds
-# alone the distinct-speed fits took 2.3 (vm) to 33 s (powerlaw) of CPU; with the second-order
-# bounds (docs/physics.md §7.4) 0.4-5.9 s; with exact Jacobians (§7.5), warm-started profiles
-# and e_vm eight points at a time 0.6-3.6 s; with line scans that skip what the bounds exclude
-# and the cell bounds' per-point terms branch-free 0.4-2.7 s; with profile crossings that
-# evaluate no point twice, the loops compiled also for AVX2 and FMA and Levenberg-Marquardt's
-# fused residuals and Jacobian 0.35-2.3 s (user + system); with the master curve fed sorted
-# kappas as vector operations and the sampled passes over a contiguous copy 0.3-1.6 s.
+# speed moved by up to 0.1% (100 000 distinct points; both written by scripts/big_fit_data.py:
+# the certified search's cost grows with them; above 16384 points its sums run on both cores, so
+# wall time depends on the machine's load). Quoted in the README (fuzzing; known limitations).
+# With the first-order cell bounds alone the distinct-speed fits took 2.3 (vm) to 33 s
+# (powerlaw) of CPU; with the second-order bounds (docs/physics.md §7.4) 0.4-5.9 s; with exact
+# Jacobians (§7.5), warm-started profiles and e_vm eight points at a time 0.6-3.6 s; with line
+# scans that skip what the bounds exclude and the cell bounds' per-point terms branch-free
+# 0.4-2.7 s; with profile crossings that evaluate no point twice, the loops compiled also for
+# AVX2 and FMA and Levenberg-Marquardt's fused residuals and Jacobian 0.35-2.3 s (user +
+# system); with the master curve fed sorted kappas as vector operations and the sampled passes
+# over a contiguous copy 0.3-1.6 s.
 #
 # Usage: bash scripts/time_big_fit.sh [BINARY]   (default target/release/restitution)
 set -euo pipefail
@@ -19,22 +20,7 @@ BIN=${1:-target/release/restitution}
 [ -x "$BIN" ] || cargo build --release --quiet
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
-python3 - "$dir" <<'PY'
-import random, sys
-d = sys.argv[1]
-lines = [l for l in open("data/fig7_nylon.csv") if not l.startswith("#") and l.strip()]
-head, rows = lines[0], lines[1:]
-random.seed(1)
-with open(f"{d}/repeated.csv", "w") as a, open(f"{d}/distinct.csv", "w") as b:
-    a.write(head)
-    b.write(head)
-    for i in range(100_000):
-        r = rows[i % len(rows)]
-        a.write(r)
-        f = r.rstrip("\n").split(",")
-        f[1] = repr(float(f[1]) * (1 + random.uniform(-1e-3, 1e-3)))
-        b.write(",".join(f) + "\n")
-PY
+python3 scripts/big_fit_data.py "$dir"
 for data in repeated distinct; do
     for m in vm pm min product powerlaw; do
         /usr/bin/time -f "$data $m: %U s user + %S s system, %e s wall" \

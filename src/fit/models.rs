@@ -265,7 +265,7 @@ impl<'a> Evaluator<'a> {
         if method == VmMethod::Master {
             let kpe = &ev.kappa_per_eta;
             ev.kappa_order = Vec::with_capacity(kpe.len());
-            for (b, block) in kpe.chunks(sums::CHUNK).enumerate() {
+            for block in kpe.chunks(sums::CHUNK) {
                 let at = ev.kappa_order.len();
                 ev.kappa_order.extend(0..block.len() as u32);
                 ev.kappa_order[at..].sort_unstable_by(|&x, &y| {
@@ -273,7 +273,6 @@ impl<'a> Evaluator<'a> {
                         .total_cmp(&block[y as usize])
                         .then(x.cmp(&y))
                 });
-                debug_assert_eq!(at, b * sums::CHUNK);
             }
             ev.kappa_per_eta_in_order = (ev.kappa_order.iter().enumerate())
                 .map(|(i, &j)| kpe[i / sums::CHUNK * sums::CHUNK + j as usize])

@@ -73,11 +73,8 @@ pub fn restitution_master(kappa: f64, rule: ContactEnd) -> Option<Restitution> {
     if !(0.0..f64::INFINITY).contains(&kappa) {
         return None;
     }
-    let (coeffs, large) = match rule {
-        ContactEnd::Overlap => (&table::OVERLAP, kappa >= KAPPA_OVERLAP_LAW),
-        ContactEnd::Force => (&table::FORCE, kappa >= KAPPA_FORCE_TABLE),
-    };
-    if large {
+    let (coeffs, large) = table_of(rule);
+    if kappa >= large {
         let e = match rule {
             ContactEnd::Overlap => asymptotic::overlap_e(kappa),
             ContactEnd::Force => asymptotic::force_e(kappa),
@@ -107,8 +104,8 @@ const LANES: usize = 8;
 /// advanced side by side keep them busy, compiled for AVX2 and FMA where the processor has them
 /// (chosen at run time, the same bits; see [`crate::cpu`]), and a group whose lanes share a
 /// piece of the table (kappas in increasing order) reads its coefficients once and runs as
-/// vector operations: 100 000 values in 1.55 ms in no order, 0.87 ms in increasing order,
-/// against 5.1 ms one at a time (ratios 0.30 and 0.17; `cargo bench --bench restitution --
+/// vector operations: 100 000 values in 1.27 ms in no order, 0.90 ms in increasing order,
+/// against 4.9 ms one at a time (ratios 0.26 and 0.18; `cargo bench --bench restitution --
 /// master_e_of_kappa_100000`, 2 shared AMD EPYC cores; 2.3 ms before the wide registers and the
 /// one-piece groups). The fit evaluates e_vm at every data point for every parameter value it
 /// tries, so on large data this is a large part of its time.
@@ -128,6 +125,15 @@ pub fn e_master_in_place(values: &mut [f64], rule: ContactEnd) -> Result<(), usi
 #[target_feature(enable = "avx2,fma")]
 unsafe fn e_master_avx2_fma(values: &mut [f64], rule: ContactEnd) -> Result<(), usize> {
     e_master_lanes(values, rule)
+}
+
+/// The rule's table and the kappa from which its large-kappa laws take over.
+#[inline(always)]
+fn table_of(rule: ContactEnd) -> (&'static [[f64; table::DEGREE + 1]; table::PIECES], f64) {
+    match rule {
+        ContactEnd::Overlap => (&table::OVERLAP, KAPPA_OVERLAP_LAW),
+        ContactEnd::Force => (&table::FORCE, KAPPA_FORCE_TABLE),
+    }
 }
 
 /// Where a group of up to LANES kappas lies on the table: [`locate`] for every lane, in a
@@ -176,10 +182,7 @@ fn group(values: &[f64], large: f64) -> Group {
 /// reads its own piece's.
 #[inline(always)]
 fn e_master_lanes(values: &mut [f64], rule: ContactEnd) -> Result<(), usize> {
-    let (coeffs, large) = match rule {
-        ContactEnd::Overlap => (&table::OVERLAP, KAPPA_OVERLAP_LAW),
-        ContactEnd::Force => (&table::FORCE, KAPPA_FORCE_TABLE),
-    };
+    let (coeffs, large) = table_of(rule);
     let n = values.len();
     let mut chunks = values.chunks_exact_mut(LANES);
     for (c, lane_values) in (&mut chunks).enumerate() {
@@ -191,28 +194,28 @@ fn e_master_lanes(values: &mut [f64], rule: ContactEnd) -> Result<(), usize> {
             ..
         } = group(lane_values, large);
         let (mut b1, mut b2) = ([0.0; LANES], [0.0; LANES]);
+        // `clenshaw` for every lane, the coefficient of step j for lane l from `$cj(j, l)`.
+        macro_rules! recur {
+            ($cj:expr) => {
+                for j in (1..=table::DEGREE).rev() {
+                    for l in 0..LANES {
+                        let b0 = $cj(j, l) + (2.0 * x[l]) * b1[l] - b2[l];
+                        b2[l] = b1[l];
+                        b1[l] = b0;
+                    }
+                }
+            };
+        }
         if uniform {
             let cs = &coeffs[piece[0]];
-            for &cj in cs[1..].iter().rev() {
-                for l in 0..LANES {
-                    let b0 = cj + (2.0 * x[l]) * b1[l] - b2[l];
-                    b2[l] = b1[l];
-                    b1[l] = b0;
-                }
-            }
+            recur!(|j: usize, _l: usize| cs[j]);
+            // Every lane on the table: no lane to hand over (a loop without a branch).
             for l in 0..LANES {
                 lane_values[l] = 1.0 - lane_values[l] * (cs[0] + x[l] * b1[l] - b2[l]);
             }
             continue;
         }
-        // `clenshaw`, lane by lane.
-        for j in (1..=table::DEGREE).rev() {
-            for l in 0..LANES {
-                let b0 = coeffs[piece[l]][j] + (2.0 * x[l]) * b1[l] - b2[l];
-                b2[l] = b1[l];
-                b1[l] = b0;
-            }
-        }
+        recur!(|j: usize, l: usize| coeffs[piece[l]][j]);
         for l in 0..LANES {
             let kappa = lane_values[l];
             lane_values[l] = if on_table[l] {
@@ -272,10 +275,7 @@ fn e_and_slope_lanes(
     slopes: &mut [f64],
     rule: ContactEnd,
 ) -> Result<(), usize> {
-    let (coeffs, large) = match rule {
-        ContactEnd::Overlap => (&table::OVERLAP, KAPPA_OVERLAP_LAW),
-        ContactEnd::Force => (&table::FORCE, KAPPA_FORCE_TABLE),
-    };
+    let (coeffs, large) = table_of(rule);
     for (c, (lane_values, lane_slopes)) in values
         .chunks_mut(LANES)
         .zip(slopes.chunks_mut(LANES))
@@ -383,13 +383,15 @@ mod tests {
             .count();
         assert!(one_piece > 50, "{one_piece} groups in one piece");
         for rule in ContactEnd::ALL {
-            // With the wide registers and without (the same bits either way).
-            for baseline in [false, true] {
-                crate::cpu::set_baseline_only(baseline);
+            // With the wide registers where the processor has them, and the baseline code
+            // called directly (the same bits either way).
+            type Way = fn(&mut [f64], ContactEnd) -> Result<(), usize>;
+            let ways: [Way; 2] = [e_master_in_place, e_master_lanes];
+            for way in ways {
                 for list in [&kappas, &sorted] {
                     for n in [0, 1, 7, 8, 9, 15, 16, 17, list.len()] {
                         let mut v = list[..n].to_vec();
-                        e_master_in_place(&mut v, rule).unwrap();
+                        way(&mut v, rule).unwrap();
                         for (k, e) in list[..n].iter().zip(&v) {
                             let want = restitution_master(*k, rule).unwrap().e;
                             assert_eq!(e.to_bits(), want.to_bits(), "{rule:?} kappa {k}");
@@ -397,7 +399,6 @@ mod tests {
                     }
                 }
             }
-            crate::cpu::set_baseline_only(false);
             // The first invalid kappa is named by its index, in a group and in the remainder.
             for (bad, at) in [(f64::NAN, 3), (-1.0, 10), (f64::INFINITY, 17)] {
                 let mut v = vec![0.5; 20];
@@ -432,14 +433,16 @@ mod tests {
             let mut plain = kappas.clone();
             e_master_in_place(&mut plain, rule).unwrap();
             // The slopes of the groups in one piece (the kappas in increasing order) and of the
-            // others, with the wide registers and without: the same bits.
+            // others, with the wide registers where there are some and the baseline code called
+            // directly: the same bits.
             let mut order: Vec<usize> = (0..kappas.len()).collect();
             order.sort_by(|&a, &b| kappas[a].total_cmp(&kappas[b]));
-            for baseline in [false, true] {
-                crate::cpu::set_baseline_only(baseline);
+            type Way = fn(&mut [f64], &mut [f64], ContactEnd) -> Result<(), usize>;
+            let ways: [Way; 2] = [e_and_slope_master_in_place, e_and_slope_lanes];
+            for way in ways {
                 let mut vs: Vec<f64> = order.iter().map(|&i| kappas[i]).collect();
                 let mut ss = vec![0.0; vs.len()];
-                e_and_slope_master_in_place(&mut vs, &mut ss, rule).unwrap();
+                way(&mut vs, &mut ss, rule).unwrap();
                 for (j, &i) in order.iter().enumerate() {
                     assert_eq!(
                         vs[j].to_bits(),
@@ -455,7 +458,6 @@ mod tests {
                     );
                 }
             }
-            crate::cpu::set_baseline_only(false);
             for (i, &k) in kappas.iter().enumerate() {
                 assert_eq!(v[i].to_bits(), plain[i].to_bits(), "{rule:?} kappa {k}");
                 let want = if k == 0.0 {
