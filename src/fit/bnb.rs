@@ -63,6 +63,16 @@ pub trait Landscape {
     fn add_row(&mut self, axis: usize, t: f64) -> Result<(), String>;
     /// chi2 at the node of rows `r` (+inf allowed; NaN only when a row failed).
     fn node(&self, r: [usize; 2]) -> f64;
+    /// chi2 at every node of the grid `rows0` x `rows1` (rows that did not fail), row-major
+    /// (`rows1` fastest): the same numbers as [`Landscape::node`], to the last bit. A landscape
+    /// may compute them together (the starting grid's nodes are most of its work).
+    fn nodes_grid(&self, rows0: &[usize], rows1: &[usize]) -> Vec<f64> {
+        rows0
+            .iter()
+            .flat_map(|&a| rows1.iter().map(move |&b| [a, b]))
+            .map(|r| self.node(r))
+            .collect()
+    }
     /// A lower bound of chi2 over the cell between rows `lo` (lower coordinate) and `hi` on each
     /// axis, and how much of its looseness each axis causes (to choose the axis to split). Only
     /// its position relative to `target` matters: an iterative bound may stop once that is
@@ -213,9 +223,40 @@ impl<L: Landscape> Bnb<L> {
             if b.axes[1].active { n0[1] } else { 1 },
         );
         // Nodes first: the best of them is the target the starting cells' bounds are judged by.
+        // The rows in the order the nodes would create them, the nodes' chi2 all together, then
+        // recorded in that order (the best node is the first of the lowest, as node by node).
+        let mut rows = [Vec::new(), Vec::new()];
         for i in 0..=c0 {
             for j in 0..=c1 {
-                b.node_at([i * s0, j * s1]);
+                let r = [b.row(0, i * s0), b.row(1, j * s1)];
+                // (An inactive axis has one row, met at every step.)
+                for k in 0..2 {
+                    if !rows[k].contains(&r[k]) {
+                        rows[k].push(r[k]);
+                    }
+                }
+            }
+        }
+        let ok = |k: usize, b: &Self| -> Vec<usize> {
+            rows[k]
+                .iter()
+                .copied()
+                .filter(|&r| b.axes[k].ok[r])
+                .collect()
+        };
+        let (ok0, ok1) = (ok(0, &b), ok(1, &b));
+        let values = b.land.nodes_grid(&ok0, &ok1);
+        let mut next = values.iter();
+        for (i, &r0) in rows[0].iter().enumerate() {
+            for (j, &r1) in rows[1].iter().enumerate() {
+                let v = if b.axes[0].ok[r0] && b.axes[1].ok[r1] {
+                    *next
+                        .next()
+                        .expect("one value per node of the rows that did not fail")
+                } else {
+                    f64::NAN
+                };
+                b.record_node([i as u64 * s0, j as u64 * s1], [r0, r1], v);
             }
         }
         b.target = b.best.map_or(f64::INFINITY, |(_, v)| v);
@@ -261,11 +302,15 @@ impl<L: Landscape> Bnb<L> {
         }
         let ok = self.axes[0].ok[r[0]] && self.axes[1].ok[r[1]];
         let v = if ok { self.land.node(r) } else { f64::NAN };
+        self.record_node(p, r, v);
+        (v, r)
+    }
+
+    fn record_node(&mut self, p: [u64; 2], r: [usize; 2], v: f64) {
         self.nodes.insert(r, v);
         if !v.is_nan() && self.best.is_none_or(|(_, b)| v < b) {
             self.best = Some((p, v));
         }
-        (v, r)
     }
 
     fn make_cell(&mut self, p0: [u64; 2], p1: [u64; 2]) -> Cell {

@@ -6,6 +6,7 @@ use super::super::objective::Objective;
 use super::super::sums;
 
 mod cell;
+mod grid;
 mod kernel;
 use cell::{CURVATURE, Cell, ROUND};
 
@@ -25,7 +26,9 @@ pub struct Separable<'a> {
     min_rule: bool,
     active: [bool; 2],
     n: usize,
-    rows: [Vec<f64>; 2],
+    /// Each row its own allocation: one growing array of every row was copied at each
+    /// reallocation and filled before being written (4% of a 100 000-point fit).
+    rows: [Vec<Vec<f64>>; 2],
     t: [Vec<f64>; 2],
     e: Vec<f64>,
     w: Vec<f64>,
@@ -115,7 +118,7 @@ impl<'a> Separable<'a> {
     }
 
     fn row(&self, k: usize, r: usize) -> &[f64] {
-        &self.rows[k][r * self.n..(r + 1) * self.n]
+        &self.rows[k][r]
     }
 
     /// The cell on the sampled points (large data).
@@ -356,15 +359,16 @@ impl Separable<'_> {
     /// Tabulates axis `axis` at `t` over every point (see [`Landscape::add_row`]).
     fn add_row_values(&mut self, axis: usize, t: f64) -> Result<(), String> {
         let (n, ev) = (self.n, self.obj.ev);
-        let start = self.rows[axis].len();
-        self.rows[axis].resize(start + n, 1.0);
         self.t[axis].push(t);
         if !self.active[axis] {
+            self.rows[axis].push(vec![1.0; n]);
             return Ok(());
         }
         self.obj.evals.set(self.obj.evals.get() + 1);
         let x = t.exp();
-        let row = &mut self.rows[axis][start..start + n];
+        // Every value is written below (a failing one as NaN).
+        self.rows[axis].push(vec![0.0; n]);
+        let row = self.rows[axis].last_mut().expect("pushed");
         if axis == 1 {
             ev.e_pm_row(x, row);
         } else {
@@ -439,8 +443,7 @@ fn newton_step(x: [f64; 2], g: [f64; 2], h: [f64; 3]) -> Option<[f64; 2]> {
 impl Landscape for Separable<'_> {
     fn add_row(&mut self, axis: usize, t: f64) -> Result<(), String> {
         let done = self.add_row_values(axis, t);
-        let start = self.rows[axis].len() - self.n;
-        let (rows, sample) = (&self.rows[axis][start..], &mut self.sample);
+        let (rows, sample) = (self.rows[axis].last().expect("added"), &mut self.sample);
         sample.rows[axis].extend(sample.points.iter().map(|&i| rows[i]));
         done
     }
@@ -465,6 +468,15 @@ impl Landscape for Separable<'_> {
             [s]
         });
         s
+    }
+
+    fn nodes_grid(&self, rows0: &[usize], rows1: &[usize]) -> Vec<f64> {
+        let f: Vec<&[f64]> = rows0.iter().map(|&r| self.row(0, r)).collect();
+        let g: Vec<&[f64]> = rows1.iter().map(|&r| self.row(1, r)).collect();
+        if f.is_empty() || g.is_empty() {
+            return Vec::new();
+        }
+        grid::nodes(&f, &g, &self.e, &self.w, self.min_rule)
     }
 
     fn bound(&self, lo: [usize; 2], hi: [usize; 2], target: f64) -> Bound {

@@ -373,3 +373,40 @@ fn the_branch_free_kernel_sums_what_the_stated_enclosure_gives_bit_for_bit() {
     // Most cases have points outside their intervals (the test is not of zeros alone).
     assert!(compared > 500, "{compared} cases with phi > 0");
 }
+
+#[test]
+fn a_grid_of_nodes_is_each_node_alone_bit_for_bit() {
+    // The starting grid's nodes summed together (four lanes, transposed blocks) against each
+    // node's own pass: the same bits, small data (one range) and large (chunks), both rules,
+    // with row counts that are not multiples of the four lanes and a point count that is not
+    // a multiple of the block.
+    for n in [121, sums::PARALLEL_MIN_POINTS + 1003] {
+        let d = data(n, true);
+        let ev = Evaluator::new(&d, ContactEnd::Overlap, VmMethod::Master);
+        for kind in KINDS {
+            let obj = Objective::new(&ev, kind).unwrap();
+            let active = [kind != ModelKind::Pm, kind != ModelKind::Vm];
+            let mut l = Separable::new(&obj, kind == ModelKind::Min, active);
+            for k in 0..5 {
+                l.add_row(0, (120.0 + 40.0 * k as f64).ln()).unwrap();
+            }
+            for k in 0..7 {
+                l.add_row(1, (1e7 * 1.6f64.powi(k)).ln()).unwrap();
+            }
+            let (r0, r1) = ([4, 0, 2, 3], [6, 1, 0, 2, 5, 3, 4]);
+            let got = l.nodes_grid(&r0, &r1);
+            let mut want = Vec::new();
+            for a in r0 {
+                for b in r1 {
+                    want.push(l.node([a, b]).to_bits());
+                }
+            }
+            assert_eq!(
+                got.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                want,
+                "{kind}, {n} points"
+            );
+            assert!(got.iter().all(|v| *v > 0.0), "{kind}: sums of squares");
+        }
+    }
+}
