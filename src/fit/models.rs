@@ -317,18 +317,35 @@ impl<'a> Evaluator<'a> {
         plastic::e_of_u(self.data.obs[i].v_n_m_s / self.v_yield_m_s(i, sigma_y_pa))
     }
 
-    /// e_pm of point `i` given sigma_y^(5/2) (computed once for all points; inlined into the
-    /// evaluations' loops, which [`crate::cpu::fast`] compiles for FMA where there is one).
-    #[inline(always)]
-    fn e_pm_s25(&self, i: usize, s25: f64) -> f64 {
-        plastic::e_of_u(self.data.obs[i].v_n_m_s / (self.v_yield_per_pa[i] * s25))
-    }
-
     /// e_pm of every point at sigma_y, into `out`.
     pub fn e_pm_row(&self, sigma_y_pa: f64, out: &mut [f64]) {
         let s25 = sigma_y_pa.powf(2.5);
         let n = self.len().min(out.len());
-        super::sums::fill(&mut out[..n], |i| self.e_pm_s25(i, s25));
+        super::sums::fill_chunks(&mut out[..n], |start, slots| {
+            self.with_e_pm(start, s25, slots, |slot, e| *slot = e)
+        });
+    }
+
+    /// `combine(slot, e_pm)` for the points `start..start + out.len()` given s25 = sigma_y^(5/2)
+    /// (sigma_y's power computed once for all points): e_pm = e(u), u = v / (V_Y per
+    /// Pa^(5/2) s25), computed a block at a time by [`plastic::e_of_u_in_place`] (four points
+    /// side by side: the same bits as [`plastic::e_of_u`] point by point; inlined into the
+    /// evaluations' loops, which [`crate::cpu::fast`] compiles for FMA where there is one).
+    #[inline(always)]
+    fn with_e_pm(&self, start: usize, s25: f64, out: &mut [f64], combine: impl Fn(&mut f64, f64)) {
+        const BLOCK: usize = 256;
+        let mut u = [0.0; BLOCK];
+        for (b, slots) in out.chunks_mut(BLOCK).enumerate() {
+            let at = start + b * BLOCK;
+            let u = &mut u[..slots.len()];
+            for (j, x) in u.iter_mut().enumerate() {
+                *x = self.data.obs[at + j].v_n_m_s / (self.v_yield_per_pa[at + j] * s25);
+            }
+            plastic::e_of_u_in_place(u);
+            for (slot, e) in slots.iter_mut().zip(u.iter()) {
+                combine(slot, *e);
+            }
+        }
     }
 
     /// The power law's e at point `i` for ln A and exponents a, b.
@@ -453,22 +470,14 @@ impl<'a> Evaluator<'a> {
             let at = |j: usize| start + j;
             match kind {
                 ModelKind::Vm => self.e_vm_chunk(start, p[0], slots)?,
-                ModelKind::Pm => {
-                    for (j, slot) in slots.iter_mut().enumerate() {
-                        *slot = self.e_pm_s25(at(j), s25);
-                    }
-                }
+                ModelKind::Pm => self.with_e_pm(start, s25, slots, |slot, e| *slot = e),
                 ModelKind::Min => {
                     self.e_vm_chunk(start, p[0], slots)?;
-                    for (j, slot) in slots.iter_mut().enumerate() {
-                        *slot = slot.min(self.e_pm_s25(at(j), s25));
-                    }
+                    self.with_e_pm(start, s25, slots, |slot, e| *slot = slot.min(e));
                 }
                 ModelKind::Product => {
                     self.e_vm_chunk(start, p[0], slots)?;
-                    for (j, slot) in slots.iter_mut().enumerate() {
-                        *slot *= self.e_pm_s25(at(j), s25);
-                    }
+                    self.with_e_pm(start, s25, slots, |slot, e| *slot *= e);
                 }
                 ModelKind::PowerLaw => {
                     let ln_a = p[0].ln();

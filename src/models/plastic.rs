@@ -111,6 +111,13 @@ fn e_and_w(u: f64) -> (f64, f64) {
         // e = 0 only for u = +inf).
         return (C_ASYMPTOTE * (corr / u.sqrt().sqrt()), f64::NAN);
     }
+    closed_form(u)
+}
+
+/// The closed form's e and w for u in (1, [`U_ASYMPTOTE`]) (the one place it is written: the
+/// single-value and the many-value evaluations both inline it).
+#[inline(always)]
+fn closed_form(u: f64) -> (f64, f64) {
     let w = (30.0 * u).mul_add(u, -5.0).sqrt();
     // q = (2/15)(w - 5), with w - 5 = 30 (u - 1)(u + 1)/(w + 5): no cancellation as u -> 1.
     let q = 4.0 * (u - 1.0) * (u + 1.0) / (w + 5.0);
@@ -121,6 +128,50 @@ fn e_and_w(u: f64) -> (f64, f64) {
     // rounding can lift the quotient to 1 + 2e-16 (seen at u = 1 + 1e-12): that is rounding, and
     // e is finite here (u in (1, 1e6)), so taking 1 hides nothing.
     (if e > 1.0 { 1.0 } else { e }, w)
+}
+
+/// e(u) in place for many u, each the same double as [`e_of_u`]'s, bit for bit. Why it exists:
+/// the fit evaluates e_pm at every data point for every yield stress it tries, and one value
+/// at a time the closed form's square roots and divisions wait on each other; four values whose
+/// u all lie in the closed form's range (1, [`U_ASYMPTOTE`]) go through it side by side as
+/// vector operations (compiled for AVX2 and FMA where the processor has them, chosen at run
+/// time: the same operations, so the same bits, see [`crate::cpu`]), and four at or below yield
+/// are 1 at once; any other group (mixed, large u, NaN) is taken value by value.
+pub fn e_of_u_in_place(values: &mut [f64]) {
+    #[cfg(target_arch = "x86_64")]
+    if crate::cpu::uses_avx2_fma() {
+        // SAFETY: the processor has the features the function is compiled for.
+        return unsafe { e_of_u_avx2_fma(values) };
+    }
+    e_of_u_lanes(values)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn e_of_u_avx2_fma(values: &mut [f64]) {
+    e_of_u_lanes(values)
+}
+
+/// [`e_of_u_in_place`]'s body (also called directly by the tests, for the baseline code).
+#[inline(always)]
+pub(crate) fn e_of_u_lanes(values: &mut [f64]) {
+    const LANES: usize = 4;
+    let mut groups = values.chunks_exact_mut(LANES);
+    for g in &mut groups {
+        let u = [g[0], g[1], g[2], g[3]];
+        if u.iter().all(|&x| x > 1.0 && x < U_ASYMPTOTE) {
+            g.copy_from_slice(&u.map(|x| closed_form(x).0));
+        } else if u.iter().all(|&x| x <= 1.0) {
+            g.fill(1.0);
+        } else {
+            for x in g.iter_mut() {
+                *x = e_of_u(*x);
+            }
+        }
+    }
+    for x in groups.into_remainder() {
+        *x = e_of_u(*x);
+    }
 }
 
 /// e(u) of [`rebound_u`] and its slope de/d(ln u), for the fit's Jacobian (exact derivatives
@@ -285,6 +336,37 @@ mod tests {
         for u in us {
             let (a, b) = (e_of_u(u), rebound_u(u).e);
             assert!(a.to_bits() == b.to_bits(), "u {u}: {a} against {b}");
+        }
+    }
+
+    #[test]
+    fn many_values_at_once_are_each_value_alone_bit_for_bit() {
+        // Groups of four wholly in the closed form's range, wholly at or below yield, and mixed
+        // ones (yield, the asymptote's hand-over, NaN, inf, subnormal), plus a tail shorter
+        // than a group; the baseline code and the dispatching one (AVX2 and FMA where the
+        // processor has them) against e_of_u value by value.
+        let mut us: Vec<f64> = (0..4003)
+            .map(|k| 10f64.powf(-1.0 + 8.0 * (k as f64 * 0.618_034).fract()))
+            .collect();
+        us.extend((0..400).map(|k| 1.0 + 1e-9 * k as f64));
+        us.extend((0..40).map(|k| 0.01 * k as f64));
+        us.extend([
+            f64::NAN,
+            1.0,
+            U_ASYMPTOTE,
+            U_ASYMPTOTE * (1.0 - 1e-16),
+            f64::MAX,
+            f64::INFINITY,
+            5e-324,
+        ]);
+        let want: Vec<u64> = us.iter().map(|&u| e_of_u(u).to_bits()).collect();
+        let mut a = us.clone();
+        e_of_u_lanes(&mut a);
+        let mut b = us.clone();
+        e_of_u_in_place(&mut b);
+        for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+            assert_eq!(x.to_bits(), want[k], "baseline, u = {}", us[k]);
+            assert_eq!(y.to_bits(), want[k], "dispatched, u = {}", us[k]);
         }
     }
 
