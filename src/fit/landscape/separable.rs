@@ -190,11 +190,19 @@ impl<'a> Separable<'a> {
         let v = if sample {
             // The chunks' sums added in chunk order, as `sums::sum` adds the full pass's (a few
             // thousand points: on this thread).
+            // The loosenesses in a loop of their own (with the second-order one inlined: in
+            // the pass it would keep the pass out of the wide registers' copy), added where
+            // the pass's loop would have added them.
             let mut v = [0.0; 13];
             for r in &self.sample.chunks {
-                let p = crate::cpu::fast(|| {
-                    Self::part_as::<MIN, FIRST, SECOND>(cell, e, w, x, r.clone(), with_loose)
+                let mut p = crate::cpu::fast(|| {
+                    Self::part_as::<MIN, FIRST, SECOND>(cell, e, w, x, r.clone(), false)
                 });
+                if with_loose {
+                    let l =
+                        crate::cpu::fast(|| Self::loose_as::<MIN, SECOND>(cell, e, w, r.clone()));
+                    p[9..].copy_from_slice(&l);
+                }
                 for (v, p) in v.iter_mut().zip(p) {
                     *v += p;
                 }
@@ -230,14 +238,9 @@ impl<'a> Separable<'a> {
         let mut s = PassSums::default();
         if with_loose {
             for i in points.clone() {
-                let (f0, f1, g0, g1) = (cell.f0[i], cell.f1[i], cell.g0[i], cell.g1[i]);
-                let c = |a: f64, b: f64| if MIN { a.min(b) } else { a * b };
-                let top = c(f0, g1);
-                let r = (top - e[i]).abs();
-                let d0 = top - c(f1, g1);
-                let d1 = top - c(f0, g0);
-                s.loose1[0] += w[i] * d0 * (r + d0);
-                s.loose1[1] += w[i] * d1 * (r + d1);
+                let l1 = loose_first::<MIN>(cell, i, w[i], e[i]);
+                s.loose1[0] += l1[0];
+                s.loose1[1] += l1[1];
                 if SECOND {
                     let l2 = cell.loose_second(i, w[i], e[i]);
                     s.loose2[0] += l2[0];
@@ -252,6 +255,29 @@ impl<'a> Separable<'a> {
         let [o0, o1] = s.loose1;
         let [n0, n1] = s.loose2;
         [t.first, t.phi, g0, g1, h0, h1, h2, a0, a1, o0, o1, n0, n1]
+    }
+
+    /// The loosenesses' sums over `points` (consecutive, in order), as `part_as` adds them:
+    /// first-order per axis, then second-order per axis (0 without SECOND).
+    #[inline(always)]
+    fn loose_as<const MIN: bool, const SECOND: bool>(
+        cell: &Cell,
+        e: &[f64],
+        w: &[f64],
+        points: std::ops::Range<usize>,
+    ) -> [f64; 4] {
+        let (mut l1, mut l2) = ([0.0; 2], [0.0; 2]);
+        for i in points {
+            let a = loose_first::<MIN>(cell, i, w[i], e[i]);
+            l1[0] += a[0];
+            l1[1] += a[1];
+            if SECOND {
+                let b = cell.loose_second_inline(i, w[i], e[i]);
+                l2[0] += b[0];
+                l2[1] += b[1];
+            }
+        }
+        [l1[0], l1[1], l2[0], l2[1]]
     }
 
     /// The cell bound: the larger of the first-order bound and tangent-plane bounds of the
@@ -395,19 +421,18 @@ impl Separable<'_> {
     fn first_order(&self, cell: &Cell) -> Bound {
         let (e, w) = (&self.e[..], &self.w[..]);
         let min_rule = self.min_rule;
-        let c = |a: f64, b: f64| if min_rule { a.min(b) } else { a * b };
         let [lb, l0, l1] = sums::sum(self.n, |points| {
             let (mut lb, mut l0, mut l1) = (0.0, 0.0, 0.0);
             for i in points {
                 let d = cell.first_order_gap(i, e[i]);
                 lb += w[i] * d * d;
-                let (f0, f1, g0, g1) = (cell.f0[i], cell.f1[i], cell.g0[i], cell.g1[i]);
-                let top = c(f0, g1);
-                let r = (top - e[i]).abs();
-                let d0 = top - c(f1, g1);
-                let d1 = top - c(f0, g0);
-                l0 += w[i] * d0 * (r + d0);
-                l1 += w[i] * d1 * (r + d1);
+                let l = if min_rule {
+                    loose_first::<true>(cell, i, w[i], e[i])
+                } else {
+                    loose_first::<false>(cell, i, w[i], e[i])
+                };
+                l0 += l[0];
+                l1 += l[1];
             }
             [lb, l0, l1]
         });
@@ -416,6 +441,19 @@ impl Separable<'_> {
             loose: [l0, l1],
         }
     }
+}
+
+/// Point i's first-order looseness per axis: how far its corner products move along each axis,
+/// weighted by its residual at the top corner.
+#[inline(always)]
+fn loose_first<const MIN: bool>(cell: &Cell, i: usize, w: f64, e: f64) -> [f64; 2] {
+    let (f0, f1, g0, g1) = (cell.f0[i], cell.f1[i], cell.g0[i], cell.g1[i]);
+    let c = |a: f64, b: f64| if MIN { a.min(b) } else { a * b };
+    let top = c(f0, g1);
+    let r = (top - e).abs();
+    let d0 = top - c(f1, g1);
+    let d1 = top - c(f0, g0);
+    [w * d0 * (r + d0), w * d1 * (r + d1)]
 }
 
 /// A Newton step on the quadratic model phi(x) + g.d + d.H d/2, projected onto [0, 1]^2: the

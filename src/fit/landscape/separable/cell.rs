@@ -225,8 +225,17 @@ impl Cell<'_> {
     }
 
     /// Point i's looseness along each axis under the second-order bound: the band's half-width
-    /// that each axis causes, weighted as the first-order looseness is.
+    /// that each axis causes, weighted as the first-order looseness is. A call, not inlined:
+    /// inlined into the passes it kept them out of their wide registers' copy (see
+    /// [`crate::cpu::fast`]); the sampled passes' own loop inlines [`Cell::loose_second_inline`].
+    #[inline(never)]
     pub(super) fn loose_second(&self, i: usize, w: f64, e: f64) -> [f64; 2] {
+        self.loose_second_inline(i, w, e)
+    }
+
+    /// [`Cell::loose_second`]'s body.
+    #[inline(always)]
+    pub(super) fn loose_second_inline(&self, i: usize, w: f64, e: f64) -> [f64; 2] {
         let (f0, f1, g0, g1) = (self.f0[i], self.f1[i], self.g0[i], self.g1[i]);
         let (df, dg) = ((f1 - f0).abs(), (g1 - g0).abs());
         let (qf, qg) = (self.q[0].min(df), self.q[1].min(dg));
