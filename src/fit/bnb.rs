@@ -67,11 +67,16 @@ pub trait Landscape {
     /// (`rows1` fastest): the same numbers as [`Landscape::node`], to the last bit. A landscape
     /// may compute them together (the starting grid's nodes are most of its work).
     fn nodes_grid(&self, rows0: &[usize], rows1: &[usize]) -> Vec<f64> {
-        rows0
+        let pairs: Vec<[usize; 2]> = rows0
             .iter()
             .flat_map(|&a| rows1.iter().map(move |&b| [a, b]))
-            .map(|r| self.node(r))
-            .collect()
+            .collect();
+        self.nodes_list(&pairs)
+    }
+    /// chi2 at each node of `pairs` (rows that did not fail), in order: the same numbers as
+    /// [`Landscape::node`], to the last bit (a split's new corners, computed together).
+    fn nodes_list(&self, pairs: &[[usize; 2]]) -> Vec<f64> {
+        pairs.iter().map(|&r| self.node(r)).collect()
     }
     /// A lower bound of chi2 over the cell between rows `lo` (lower coordinate) and `hi` on each
     /// axis, and how much of its looseness each axis causes (to choose the axis to split). Only
@@ -306,6 +311,35 @@ impl<L: Landscape> Bnb<L> {
         (v, r)
     }
 
+    /// [`Bnb::node_at`] at each of `ps` in order (the same rows created in the same order, the
+    /// same nodes recorded in the same order), the chi2 of the new ones computed together.
+    fn nodes_at(&mut self, ps: &[[u64; 2]]) {
+        let mut new: Vec<([u64; 2], [usize; 2])> = Vec::new();
+        for &p in ps {
+            let r = [self.row(0, p[0]), self.row(1, p[1])];
+            if !self.nodes.contains_key(&r) && !new.iter().any(|(_, q)| *q == r) {
+                new.push((p, r));
+            }
+        }
+        let ok = |s: &Self, r: [usize; 2]| s.axes[0].ok[r[0]] && s.axes[1].ok[r[1]];
+        let pairs: Vec<[usize; 2]> = new
+            .iter()
+            .map(|&(_, r)| r)
+            .filter(|&r| ok(self, r))
+            .collect();
+        let mut values = self.land.nodes_list(&pairs).into_iter();
+        for (p, r) in new {
+            let v = if ok(self, r) {
+                values
+                    .next()
+                    .expect("one value per node of rows that did not fail")
+            } else {
+                f64::NAN
+            };
+            self.record_node(p, r, v);
+        }
+    }
+
     fn record_node(&mut self, p: [u64; 2], r: [usize; 2], v: f64) {
         self.nodes.insert(r, v);
         if !v.is_nan() && self.best.is_none_or(|(_, b)| v < b) {
@@ -467,13 +501,25 @@ impl<L: Landscape> Bnb<L> {
                 vec![(c.p0[k], c.p1[k])]
             }
         };
-        let mut out = Vec::with_capacity(4);
+        let mut corners = Vec::with_capacity(4);
         for (a0, a1) in cuts(0) {
             for (b0, b1) in cuts(1) {
-                out.push(self.make_cell([a0, b0], [a1, b1]));
+                corners.push(([a0, b0], [a1, b1]));
             }
         }
-        Split::Cells(out)
+        // The children's new nodes together, in the order their cells would meet them.
+        self.nodes_at(
+            &corners
+                .iter()
+                .flat_map(|&(p0, p1)| [p0, [p1[0], p0[1]], [p0[0], p1[1]], p1])
+                .collect::<Vec<_>>(),
+        );
+        Split::Cells(
+            corners
+                .into_iter()
+                .map(|(p0, p1)| self.make_cell(p0, p1))
+                .collect(),
+        )
     }
 
     /// Whether the point at internal coordinates `t` may have chi2 below `target` as far as the

@@ -517,6 +517,17 @@ impl Landscape for Separable<'_> {
         grid::nodes(&f, &g, &self.e, &self.w, self.min_rule)
     }
 
+    fn nodes_list(&self, pairs: &[[usize; 2]]) -> Vec<f64> {
+        let rows: Vec<(&[f64], &[f64])> = pairs
+            .iter()
+            .map(|r| (self.row(0, r[0]), self.row(1, r[1])))
+            .collect();
+        if rows.is_empty() {
+            return Vec::new();
+        }
+        grid::list(&rows, &self.e, &self.w, self.min_rule)
+    }
+
     fn bound(&self, lo: [usize; 2], hi: [usize; 2], target: f64) -> Bound {
         self.bound_with(lo, hi, Some(target))
     }

@@ -1,15 +1,16 @@
-//! The chi2 of a whole grid of nodes (rows of e_vm x rows of e_pm) in one pass over the points,
-//! for the search's starting grid (hundreds of nodes, each alone a pass whose single running
-//! sum waits on its previous addition at every point).
+//! The chi2 of many nodes in one pass over the points: a whole grid (rows of e_vm x rows of
+//! e_pm, the search's starting grid: hundreds of nodes) or a list (a split's new corners), where
+//! each node alone is a pass whose single running sum waits on its previous addition at every
+//! point.
 //!
 //! The same numbers as [`super::Separable`]'s node by node, to the last bit: each node's terms
 //! are w (c(f, g) - e)^2 formed in the same order of operations (no fused multiply-add: Rust
 //! never fuses on its own, and `wide` lanes are IEEE operations lane by lane), added into its
 //! own running sum in point order within each chunk of [`sums::CHUNK`] (one range for small
 //! data), and the chunks' sums added in chunk order, as [`sums::sum`] does. What changes is
-//! only which node's addition waits for which: four nodes (one per lane) advance together, and
-//! a block of points' e_pm values is first transposed so that a point's four nodes are one
-//! load.
+//! only which node's addition waits for which: four nodes (one per lane) advance together (for
+//! the grid, a block of points' e_pm values is first transposed so that a point's four nodes
+//! are one load).
 
 use super::super::super::sums;
 use rayon::prelude::*;
@@ -22,14 +23,6 @@ const BLOCK: usize = 128;
 /// chi2 at every node (a, b) of `f` x `g` (row-major, `g` fastest): sum_i w_i (c(f_a,i,
 /// g_b,i) - e_i)^2 with c = min (`min_rule`) or the product.
 pub(super) fn nodes(f: &[&[f64]], g: &[&[f64]], e: &[f64], w: &[f64], min_rule: bool) -> Vec<f64> {
-    let n = e.len();
-    let ranges: Vec<std::ops::Range<usize>> = if sums::is_large(n) {
-        (0..n.div_ceil(sums::CHUNK))
-            .map(|c| c * sums::CHUNK..((c + 1) * sums::CHUNK).min(n))
-            .collect()
-    } else {
-        vec![0..n]
-    };
     let part = |r: std::ops::Range<usize>| {
         if min_rule {
             part_as::<true>(f, g, e, w, r)
@@ -37,21 +30,71 @@ pub(super) fn nodes(f: &[&[f64]], g: &[&[f64]], e: &[f64], w: &[f64], min_rule: 
             part_as::<false>(f, g, e, w, r)
         }
     };
+    in_chunks(e.len(), f.len() * g.len(), part)
+}
+
+/// chi2 at each node (f, g) of `pairs`, in order, as [`nodes`] sums them.
+pub(super) fn list(pairs: &[(&[f64], &[f64])], e: &[f64], w: &[f64], min_rule: bool) -> Vec<f64> {
+    let part = |r: std::ops::Range<usize>| {
+        if min_rule {
+            list_part::<true>(pairs, e, w, r)
+        } else {
+            list_part::<false>(pairs, e, w, r)
+        }
+    };
+    in_chunks(e.len(), pairs.len(), part)
+}
+
+/// The sums `part` gives over each range of the points (one for small data, the chunks of
+/// [`sums::CHUNK`] in parallel for large), added in range order as [`sums::sum`] adds them.
+fn in_chunks(
+    n: usize,
+    k: usize,
+    part: impl Fn(std::ops::Range<usize>) -> Vec<f64> + Sync,
+) -> Vec<f64> {
     let parts: Vec<Vec<f64>> = if sums::is_large(n) {
-        ranges
+        (0..n.div_ceil(sums::CHUNK))
             .into_par_iter()
-            .map(|r| crate::cpu::fast(|| part(r)))
+            .map(|c| crate::cpu::fast(|| part(c * sums::CHUNK..((c + 1) * sums::CHUNK).min(n))))
             .collect()
     } else {
-        ranges.into_iter().map(part).collect()
+        vec![part(0..n)]
     };
-    let mut total = vec![0.0; f.len() * g.len()];
+    let mut total = vec![0.0; k];
     for p in parts {
         for (t, v) in total.iter_mut().zip(p) {
             *t += v;
         }
     }
     total
+}
+
+/// [`list`]'s sums over the points `r`, four nodes at a time, each in point order.
+#[inline(always)]
+fn list_part<const MIN: bool>(
+    pairs: &[(&[f64], &[f64])],
+    e: &[f64],
+    w: &[f64],
+    r: std::ops::Range<usize>,
+) -> Vec<f64> {
+    let mut out = Vec::with_capacity(pairs.len());
+    for group in pairs.chunks(4) {
+        // A short last group repeats its last node (its sums dropped).
+        let lane = |l: usize| group[l.min(group.len() - 1)];
+        let f = [0, 1, 2, 3].map(|l| &lane(l).0[r.clone()]);
+        let g = [0, 1, 2, 3].map(|l| &lane(l).1[r.clone()]);
+        let (e, w) = (&e[r.clone()], &w[r.clone()]);
+        let mut s = f64x4::ZERO;
+        for j in 0..e.len() {
+            let fj = f64x4::new(f.map(|x| x[j]));
+            let gj = f64x4::new(g.map(|x| x[j]));
+            let c = if MIN { fj.min(gj) } else { fj * gj };
+            let d = c - f64x4::splat(e[j]);
+            s += f64x4::splat(w[j]) * d * d;
+        }
+        out.extend_from_slice(&s.to_array()[..group.len()]);
+    }
+    out
 }
 
 /// The nodes' sums over the points `r`, each in point order.

@@ -376,7 +376,7 @@ fn the_branch_free_kernel_sums_what_the_stated_enclosure_gives_bit_for_bit() {
 
 #[test]
 fn a_grid_of_nodes_is_each_node_alone_bit_for_bit() {
-    // The starting grid's nodes summed together (four lanes, transposed blocks) against each
+    // The starting grid's nodes (and a list of nodes) summed together (four lanes, transposed blocks) against each
     // node's own pass: the same bits, small data (one range) and large (chunks), both rules,
     // with row counts that are not multiples of the four lanes and a point count that is not
     // a multiple of the block.
@@ -407,6 +407,16 @@ fn a_grid_of_nodes_is_each_node_alone_bit_for_bit() {
                 "{kind}, {n} points"
             );
             assert!(got.iter().all(|v| *v > 0.0), "{kind}: sums of squares");
+            // A list of nodes (a split's new corners), five of them: a full group of four
+            // lanes and a short one, repeats allowed.
+            let pairs = [[0, 0], [4, 6], [2, 2], [3, 5], [2, 2]];
+            let got = l.nodes_list(&pairs);
+            let want: Vec<u64> = pairs.iter().map(|&r| l.node(r).to_bits()).collect();
+            assert_eq!(
+                got.iter().map(|v| v.to_bits()).collect::<Vec<_>>(),
+                want,
+                "{kind}, {n} points, list"
+            );
         }
     }
 }
