@@ -83,11 +83,14 @@ impl Evaluator<'_> {
             Some((e, f)) => (e, f),
             None => (&[][..], &mut [][..]),
         };
+        // A factor whose parameter is held (a profile's) needs its values, not its slopes: the
+        // same values without the slopes' work.
+        let slope = [axes.contains(&0), axes.contains(&1)];
         let chunk = |start: usize, c0: &mut [f64], c1: &mut [f64], f: &mut [f64]| -> Result<()> {
             let m = c0.len();
             let (mut ev, mut sv) = (vec![1.0; m], vec![0.0; m]);
             if kind != ModelKind::Pm {
-                self.vm_in_kappa_order(start, eta, &mut ev, Some(&mut sv))?;
+                self.vm_in_kappa_order(start, eta, &mut ev, slope[0].then_some(&mut sv[..]))?;
             }
             for j in 0..m {
                 let i = start + j;
@@ -96,8 +99,12 @@ impl Evaluator<'_> {
                     (1.0, 0.0)
                 } else {
                     let u = self.data.obs[i].v_n_m_s / (self.v_yield_per_pa[i] * s25);
-                    let (e, s) = plastic::e_and_slope_ln_u(u);
-                    (e, -2.5 * s)
+                    if slope[1] {
+                        let (e, s) = plastic::e_and_slope_ln_u(u);
+                        (e, -2.5 * s)
+                    } else {
+                        (plastic::e_of_u(u), 0.0)
+                    }
                 };
                 let d = match kind {
                     ModelKind::Min if ev[j] < ep => [sv[j], 0.0],
