@@ -2,8 +2,8 @@
 """High-precision reference values of exp(x), for the four-lane exp (src/fit/vexp.rs).
 
 Arguments: 2000 seeded uniform doubles over [-708, 708] (the vector method's range), doubles at
-and next to the ends of the range-reduction intervals (k ln2 +- ln2/2, where the reduced
-argument is largest) and a few round numbers. Each argument is written as the shortest decimal
+and next to the ends of range-reduction intervals (k ln2 +- ln2/2, and the table method's
+k ln2/128 +- ln2/256, where the reduced argument is largest) and a few round numbers. Each argument is written as the shortest decimal
 that parses back to the same double, and exp of that double is computed by mpmath at 40 and at
 60 digits; the two must agree to 1e-38 relative, and the 40-digit decimal must parse (Python's
 float, correctly rounded like Rust's) to the double nearest the 60-digit value.
@@ -28,6 +28,12 @@ def arguments():
     ln2 = math.log(2.0)
     for k in list(range(-1020, 1021, 73)) + [-1, 0, 1]:
         for t in (k * ln2 + 0.5 * ln2, k * ln2 - 0.5 * ln2):
+            if abs(t) < 707.9:
+                xs += [t, math.nextafter(t, math.inf), math.nextafter(t, -math.inf)]
+    # The table method's reduction intervals, k ln2/128 +- ln2/256: over the power law's [-8, 0]
+    # and a few far out.
+    for k in list(range(-1478, 1, 37)) + list(range(-130000, 130001, 9973)):
+        for t in (k * ln2 / 128 + ln2 / 256, k * ln2 / 128 - ln2 / 256):
             if abs(t) < 707.9:
                 xs += [t, math.nextafter(t, math.inf), math.nextafter(t, -math.inf)]
     xs += [0.0, 1.0, -1.0, 0.5, -0.5, ln2, 1e-10, -1e-10, 10.0, -10.0, 100.0, -100.0,
