@@ -19,6 +19,7 @@ pub mod result;
 pub mod scalar;
 pub mod search;
 pub mod sums;
+pub mod vexp;
 pub mod walton;
 
 pub use compare::{Comparison, ComparisonRow, compare};

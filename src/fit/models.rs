@@ -19,6 +19,7 @@
 
 use super::dataset::FitData;
 use super::sums;
+use super::vexp;
 use crate::contact::Contact;
 use crate::error::{Error, Result};
 use crate::models::plastic;
@@ -348,9 +349,19 @@ impl<'a> Evaluator<'a> {
         }
     }
 
-    /// The power law's e at point `i` for ln A and exponents a, b.
-    fn e_powerlaw(&self, i: usize, ln_a: f64, a: f64, b: f64) -> f64 {
-        1.0 - (ln_a - a * self.powerlaw_ln_d[i] + b * self.powerlaw_ln_v[i]).exp()
+    /// The power law's e at the points `start..start + out.len()` for ln A and exponents a, b,
+    /// into `out`: 1 - exp(ln A - a x1 + b x2), the exps four at a time ([`vexp`]; each value
+    /// from its own point alone; inf and NaN where the model overflows, as with `f64::exp`).
+    fn e_powerlaw(&self, start: usize, ln_a: f64, a: f64, b: f64, out: &mut [f64]) {
+        let at = start..start + out.len();
+        let (x1, x2) = (&self.powerlaw_ln_d[at.clone()], &self.powerlaw_ln_v[at]);
+        for ((o, x1), x2) in out.iter_mut().zip(x1).zip(x2) {
+            *o = ln_a - a * x1 + b * x2;
+        }
+        vexp::exp_in_place(out);
+        for o in out.iter_mut() {
+            *o = 1.0 - *o;
+        }
     }
 
     /// e_vm of the points `start..start + out.len()` at damping eta, into `out`; an error is
@@ -479,12 +490,7 @@ impl<'a> Evaluator<'a> {
                     self.e_vm_chunk(start, p[0], slots)?;
                     self.with_e_pm(start, s25, slots, |slot, e| *slot *= e);
                 }
-                ModelKind::PowerLaw => {
-                    let ln_a = p[0].ln();
-                    for (j, slot) in slots.iter_mut().enumerate() {
-                        *slot = self.e_powerlaw(at(j), ln_a, p[1], p[2]);
-                    }
-                }
+                ModelKind::PowerLaw => self.e_powerlaw(start, p[0].ln(), p[1], p[2], slots),
             }
             finish(start, slots);
             Ok(())

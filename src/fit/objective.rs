@@ -180,8 +180,18 @@ impl<'a> Objective<'a> {
         let n = self.ev.len();
         let mut q = vec![0.0; n];
         let inv_sigma = &self.inv_sigma;
-        super::sums::fill(&mut q, |i| {
-            (theta[0] - theta[1] * x1[i] + theta[2] * x2[i]).exp() * inv_sigma[i]
+        // q_i = exp(ln A - a x1 + b x2) / sigma_i, the exps four at a time (each from its own
+        // point: the same numbers for any chunking).
+        super::sums::fill_chunks(&mut q, |start, q| {
+            let at = start..start + q.len();
+            let (x1, x2) = (&x1[at.clone()], &x2[at.clone()]);
+            for ((q, x1), x2) in q.iter_mut().zip(x1).zip(x2) {
+                *q = theta[0] - theta[1] * x1 + theta[2] * x2;
+            }
+            super::vexp::exp_in_place(q);
+            for (q, w) in q.iter_mut().zip(&inv_sigma[at]) {
+                *q *= w;
+            }
         });
         let cols = (0..3).filter(|&j| free[j]);
         for (c, j) in cols.enumerate() {
