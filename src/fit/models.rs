@@ -478,7 +478,6 @@ impl<'a> Evaluator<'a> {
             _ => f64::NAN,
         };
         let chunk = |start: usize, slots: &mut [f64]| -> Result<()> {
-            let at = |j: usize| start + j;
             match kind {
                 ModelKind::Vm => self.e_vm_chunk(start, p[0], slots)?,
                 ModelKind::Pm => self.with_e_pm(start, s25, slots, |slot, e| *slot = e),
