@@ -43,7 +43,7 @@
 use super::super::super::qp;
 use super::super::super::sums;
 use super::lanes::{self, load};
-use wide::{CmpGt, CmpLt, f64x4};
+use wide::f64x4;
 
 /// Relative widening of the model's range and of A's box (see the module doc).
 pub(super) const EPS: f64 = 1e-12;
@@ -113,54 +113,106 @@ struct Pass {
 /// The sums per point: phi, g (3), H (6), tails (2 x 2).
 const SUMS: usize = 14;
 
+/// One point's numbers in a pass.
+#[derive(Clone, Copy)]
+struct Point {
+    y: f64,
+    w: f64,
+    c1: f64,
+    c2: f64,
+    zc: f64,
+    zhi: f64,
+    zlo: f64,
+    rz: f64,
+}
+
+/// One point's terms of the [`SUMS`] sums at x, with the tails at the amplitudes `at`.
+#[inline(always)]
+fn point_terms(p: Point, x: [f64; 3], at: [f64; 2]) -> [f64; SUMS] {
+    let Point {
+        y,
+        w,
+        c1,
+        c2,
+        zc,
+        zhi,
+        zlo,
+        rz,
+    } = p;
+    let [a, pp, q] = x;
+    // `c` ? `v` : +0 (a select).
+    let sel = |c: bool, v: f64| if c { v } else { 0.0 };
+    let lin = zc * (a - c1 * pp + c2 * q);
+    let ezhi = EPS * zhi;
+    let widen = a * ezhi + ABS * (2.0 + y.abs());
+    let u = lin - widen - y;
+    let v = lin + a * rz + widen - y;
+    let (below, above) = (u > 0.0, v < 0.0);
+    // The active end's signed distance and its gradient (A's coefficient; P's and Q's are the
+    // same at both ends).
+    let r = sel(below, u) + sel(above, v);
+    let a0 = sel(below, zc - ezhi) + sel(above, zc + rz + ezhi);
+    let act = sel(below, zc) + sel(above, zc);
+    let (a1, a2) = (-act * c1, act * c2);
+    let wr = w * r;
+    let (wa0, wa1) = (w * a0, w * a1);
+    let mut t = [0.0; SUMS];
+    t[0] = wr * r;
+    t[1] = wr * a0;
+    t[2] = wr * a1;
+    t[3] = wr * a2;
+    t[4] = wa0 * a0;
+    t[5] = wa0 * a1;
+    t[6] = wa0 * a2;
+    t[7] = wa1 * a1;
+    t[8] = wa1 * a2;
+    t[9] = w * a2 * a2;
+    for (k, at) in at.into_iter().enumerate() {
+        // max(., 0) as a select: +0 for a NaN or a -0 (as the SSE2 max it replaces).
+        let pos = |v: f64| if v > 0.0 { v } else { 0.0 };
+        let pu = pos(at * zlo - y);
+        let pv = pos(y - at * zhi);
+        t[10 + 2 * k] = w * (pu * pu + pv * pv);
+        t[11 + 2 * k] = w * (zlo * pu - zhi * pv);
+    }
+    t
+}
+
 fn pass(c: &Cell, x: [f64; 3], at: [f64; 2]) -> Pass {
     let n = c.y.len();
-    let splat = f64x4::splat;
-    let (a, p, q) = (splat(x[0]), splat(x[1]), splat(x[2]));
-    let (eps, abs, two, zero) = (splat(EPS), splat(ABS), splat(2.0), f64x4::ZERO);
-    let at = at.map(splat);
-    // Four points at a time ([`lanes`]), branch-free: the active end is chosen by masks (u > 0:
-    // the lower end is above y; v < 0: the upper end is below it; u <= v, so at most one).
+    // Four points at a time ([`lanes`]: point j of a range in lane j mod 4, each lane summed in
+    // point order), branch-free: the active end is chosen by selects (u > 0: the lower end is
+    // above y; v < 0: the upper end is below it; u <= v, so at most one). Plain arrays of four,
+    // not `wide`'s SSE2 pairs: in the AVX2 copy the compiler keeps the fourteen sums in
+    // 256-bit registers (as pairs they spilled to the stack at every group of points). The
+    // same operations lane by lane, so the same numbers.
     let s = sums::sum::<SUMS>(n, |points| {
         let r = points;
         let [y, w, c1, c2] = lanes::slices(&r, [c.y, c.w, c.c1, c.c2]);
         let [zc, zhi, zlo, rz] = lanes::slices(&r, [c.zc, c.zhi, c.zlo, c.rz]);
-        let mut s = [zero; SUMS];
+        let mut s = [[0.0; lanes::LANES]; SUMS];
         for b in (0..r.len()).step_by(lanes::LANES) {
-            let (y, w, c1, c2) = (load(y, b), load(w, b), load(c1, b), load(c2, b));
-            let (zc, zhi, zlo, rz) = (load(zc, b), load(zhi, b), load(zlo, b), load(rz, b));
-            let lin = zc * (a - c1 * p + c2 * q);
-            let ezhi = eps * zhi;
-            let widen = a * ezhi + abs * (two + y.abs());
-            let u = lin - widen - y;
-            let v = lin + a * rz + widen - y;
-            let (below, above) = (u.cmp_gt(zero), v.cmp_lt(zero));
-            // The active end's signed distance and its gradient (A's coefficient; P's and Q's
-            // are the same at both ends).
-            let r = (below & u) + (above & v);
-            let a0 = (below & (zc - ezhi)) + (above & (zc + rz + ezhi));
-            let act = (below & zc) + (above & zc);
-            let (a1, a2) = (-act * c1, act * c2);
-            let wr = w * r;
-            s[0] += wr * r;
-            s[1] += wr * a0;
-            s[2] += wr * a1;
-            s[3] += wr * a2;
-            let (wa0, wa1) = (w * a0, w * a1);
-            s[4] += wa0 * a0;
-            s[5] += wa0 * a1;
-            s[6] += wa0 * a2;
-            s[7] += wa1 * a1;
-            s[8] += wa1 * a2;
-            s[9] += w * a2 * a2;
-            for (k, t) in at.into_iter().enumerate() {
-                let pu = (t * zlo - y).max(zero);
-                let pv = (y - t * zhi).max(zero);
-                s[10 + 2 * k] += w * (pu * pu + pv * pv);
-                s[11 + 2 * k] += w * (zlo * pu - zhi * pv);
+            let ld = |v: &[f64]| load(v, b).to_array();
+            let (y, w, c1, c2) = (ld(y), ld(w), ld(c1), ld(c2));
+            let (zc, zhi, zlo, rz) = (ld(zc), ld(zhi), ld(zlo), ld(rz));
+            for l in 0..lanes::LANES {
+                let p = Point {
+                    y: y[l],
+                    w: w[l],
+                    c1: c1[l],
+                    c2: c2[l],
+                    zc: zc[l],
+                    zhi: zhi[l],
+                    zlo: zlo[l],
+                    rz: rz[l],
+                };
+                let t = point_terms(p, x, at);
+                for (s, t) in s.iter_mut().zip(t) {
+                    s[l] += t;
+                }
             }
         }
-        s.map(lanes::total)
+        s.map(|v| (v[0] + v[1]) + (v[2] + v[3]))
     });
     Pass {
         phi: s[0],
