@@ -11,7 +11,9 @@
 # 0.4-2.7 s; with profile crossings that evaluate no point twice, the loops compiled also for
 # AVX2 and FMA and Levenberg-Marquardt's fused residuals and Jacobian 0.35-2.3 s (user +
 # system); with the master curve fed sorted kappas as vector operations and the sampled passes
-# over a contiguous copy 0.3-1.6 s.
+# over a contiguous copy 0.3-1.6 s; with the cell bound's sums in registers, nodes summed four
+# per vector lane, e_pm and the power law's exps four at a time and its linearised pass on
+# 256-bit lanes 0.3-1.5 s.
 #
 # Usage: bash scripts/time_big_fit.sh [BINARY]   (default target/release/restitution)
 set -euo pipefail
