@@ -16,8 +16,8 @@ use super::super::super::sums;
 use rayon::prelude::*;
 use wide::f64x4;
 
-/// Points per transposed block: BLOCK x (e_pm rows) values stay in the first-level cache for
-/// the grid's size (17 rows: 17 KB).
+/// Points per transposed block: BLOCK x (e_pm rows, rounded up to groups of four) values stay
+/// in the first-level cache for the search's grid (17 rows: 128 x 20 x 8 bytes, 20 KB).
 const BLOCK: usize = 128;
 
 /// chi2 at every node (a, b) of `f` x `g` (row-major, `g` fastest): sum_i w_i (c(f_a,i,
@@ -46,7 +46,8 @@ pub(super) fn list(pairs: &[(&[f64], &[f64])], e: &[f64], w: &[f64], min_rule: b
 }
 
 /// The sums `part` gives over each range of the points (one for small data, the chunks of
-/// [`sums::CHUNK`] in parallel for large), added in range order as [`sums::sum`] adds them.
+/// [`sums::CHUNK`] in parallel for large), added in range order as [`sums::sum`] adds them
+/// (starting from +0, which leaves a single range's sum of squares as it is).
 fn in_chunks(
     n: usize,
     k: usize,
