@@ -251,19 +251,14 @@ impl<L: Landscape> Bnb<L> {
         };
         let (ok0, ok1) = (ok(0, &b), ok(1, &b));
         let values = b.land.nodes_grid(&ok0, &ok1);
-        let mut next = values.iter();
-        for (i, &r0) in rows[0].iter().enumerate() {
-            for (j, &r1) in rows[1].iter().enumerate() {
-                let v = if b.axes[0].ok[r0] && b.axes[1].ok[r1] {
-                    *next
-                        .next()
-                        .expect("one value per node of the rows that did not fail")
-                } else {
-                    f64::NAN
-                };
-                b.record_node([i as u64 * s0, j as u64 * s1], [r0, r1], v);
-            }
-        }
+        // Row-major over the rows, as the values over the rows that did not fail.
+        let nodes: Vec<([u64; 2], [usize; 2])> = (rows[0].iter().enumerate())
+            .flat_map(|(i, &r0)| {
+                (rows[1].iter().enumerate())
+                    .map(move |(j, &r1)| ([i as u64 * s0, j as u64 * s1], [r0, r1]))
+            })
+            .collect();
+        b.record_nodes(nodes, values);
         b.target = b.best.map_or(f64::INFINITY, |(_, v)| v);
         for i in 0..c0 {
             for j in 0..c1 {
@@ -305,8 +300,11 @@ impl<L: Landscape> Bnb<L> {
         if let Some(&v) = self.nodes.get(&r) {
             return (v, r);
         }
-        let ok = self.axes[0].ok[r[0]] && self.axes[1].ok[r[1]];
-        let v = if ok { self.land.node(r) } else { f64::NAN };
+        let v = if self.rows_ok(r) {
+            self.land.node(r)
+        } else {
+            f64::NAN
+        };
         self.record_node(p, r, v);
         (v, r)
     }
@@ -321,18 +319,28 @@ impl<L: Landscape> Bnb<L> {
                 new.push((p, r));
             }
         }
-        let ok = |s: &Self, r: [usize; 2]| s.axes[0].ok[r[0]] && s.axes[1].ok[r[1]];
         let pairs: Vec<[usize; 2]> = new
             .iter()
             .map(|&(_, r)| r)
-            .filter(|&r| ok(self, r))
+            .filter(|&r| self.rows_ok(r))
             .collect();
-        let mut values = self.land.nodes_list(&pairs).into_iter();
-        for (p, r) in new {
-            let v = if ok(self, r) {
+        let values = self.land.nodes_list(&pairs);
+        self.record_nodes(new, values);
+    }
+
+    fn rows_ok(&self, r: [usize; 2]) -> bool {
+        self.axes[0].ok[r[0]] && self.axes[1].ok[r[1]]
+    }
+
+    /// Records `nodes` in order: the next of `values` (computed for the nodes whose rows did
+    /// not fail, in the same order) for each such node, NaN for the others.
+    fn record_nodes(&mut self, nodes: Vec<([u64; 2], [usize; 2])>, values: Vec<f64>) {
+        let mut values = values.into_iter();
+        for (p, r) in nodes {
+            let v = if self.rows_ok(r) {
                 values
                     .next()
-                    .expect("one value per node of rows that did not fail")
+                    .expect("one value per node of the rows that did not fail")
             } else {
                 f64::NAN
             };

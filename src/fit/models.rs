@@ -327,6 +327,12 @@ impl<'a> Evaluator<'a> {
         });
     }
 
+    /// u = v / V_Y of point `i` given s25 = sigma_y^(5/2) (V_Y = V_Y per Pa^(5/2) x s25).
+    #[inline(always)]
+    pub(super) fn u_s25(&self, i: usize, s25: f64) -> f64 {
+        self.data.obs[i].v_n_m_s / (self.v_yield_per_pa[i] * s25)
+    }
+
     /// `combine(slot, e_pm)` for the points `start..start + out.len()` given s25 = sigma_y^(5/2)
     /// (sigma_y's power computed once for all points): e_pm = e(u), u = v / (V_Y per
     /// Pa^(5/2) s25), computed a block at a time by [`plastic::e_of_u_in_place`] (four points
@@ -340,7 +346,7 @@ impl<'a> Evaluator<'a> {
             let at = start + b * BLOCK;
             let u = &mut u[..slots.len()];
             for (j, x) in u.iter_mut().enumerate() {
-                *x = self.data.obs[at + j].v_n_m_s / (self.v_yield_per_pa[at + j] * s25);
+                *x = self.u_s25(at + j, s25);
             }
             plastic::e_of_u_in_place(u);
             for (slot, e) in slots.iter_mut().zip(u.iter()) {

@@ -98,7 +98,7 @@ impl Evaluator<'_> {
                 let (ep, sp) = if kind == ModelKind::Vm {
                     (1.0, 0.0)
                 } else {
-                    let u = self.data.obs[i].v_n_m_s / (self.v_yield_per_pa[i] * s25);
+                    let u = self.u_s25(i, s25);
                     if slope[1] {
                         let (e, s) = plastic::e_and_slope_ln_u(u);
                         (e, -2.5 * s)

@@ -55,7 +55,12 @@ pub(super) fn store(s: &mut [f64], b: usize, g: f64x4) {
 /// The sum of the lanes, (l0 + l1) + (l2 + l3).
 #[inline(always)]
 pub(super) fn total(v: f64x4) -> f64 {
-    let l = v.to_array();
+    total_of(v.to_array())
+}
+
+/// [`total`] of four lanes held as an array.
+#[inline(always)]
+pub(super) fn total_of(l: [f64; LANES]) -> f64 {
     (l[0] + l[1]) + (l[2] + l[3])
 }
 

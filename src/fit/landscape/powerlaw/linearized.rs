@@ -212,7 +212,7 @@ fn pass(c: &Cell, x: [f64; 3], at: [f64; 2]) -> Pass {
                 }
             }
         }
-        s.map(|v| (v[0] + v[1]) + (v[2] + v[3]))
+        s.map(lanes::total_of)
     });
     Pass {
         phi: s[0],
