@@ -354,6 +354,21 @@ fn undetermined_parameters_are_bounds_not_numbers() {
 }
 
 #[test]
+fn models_fitted_together_are_fitted_as_alone() {
+    // fit_all shares one evaluator (and its rows of e_vm and e_pm) between the models' searches,
+    // which run side by side: each fit must be the one it is alone, to the last bit, whatever
+    // the other models computed first. Truth min, so that the models' searches go different
+    // ways through the shared rows.
+    let pts = design(&SIZES, 0.3, 30.0, 8);
+    let data = synth(ModelKind::Min, &[190.0, 4e7], &pts, |_, _| 0.01, Some(5));
+    let set = fit_all(&data, &ModelKind::ALL, &FitOptions::default()).unwrap();
+    for (together, kind) in set.fits.iter().zip(ModelKind::ALL) {
+        let alone = fit(&data, kind, &FitOptions::default()).unwrap();
+        assert_eq!(*together, alone, "{kind}");
+    }
+}
+
+#[test]
 fn information_criteria_and_preference() {
     // Weighted: AIC = chi2 + 2k, BIC = chi2 + k ln n (Burnham & Anderson); weights sum to 1; the
     // preferred model for VM data is vm, not min with the same chi2 and one more parameter.

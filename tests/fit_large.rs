@@ -11,7 +11,7 @@ use restitution::contact::Material;
 use restitution::fit::dataset::pair_contact;
 use restitution::fit::models::predict_e;
 use restitution::fit::sums::PARALLEL_MIN_POINTS;
-use restitution::fit::{FitData, FitOptions, ModelKind, Observation, fit};
+use restitution::fit::{FitData, FitOptions, ModelKind, Observation, fit, fit_all};
 use restitution::models::viscoelastic::{ContactEnd, VmMethod};
 
 /// 20 000 points (above the parallel threshold) on nylon pairs of 6.35, 12.7 and 25.4 mm, every
@@ -72,8 +72,10 @@ fn many_distinct_points_give_the_certified_optimum_of_the_point_order_sums() {
         data.len() >= PARALLEL_MIN_POINTS,
         "the test must take the chunked path"
     );
+    let mut alone = Vec::new();
     for (kind, best, chi2) in REFERENCE {
         let r = fit(&data, kind, &FitOptions::default()).unwrap();
+        alone.push(r.clone());
         let got: Vec<f64> = r.params.iter().map(|p| p.best_fit).collect();
         eprintln!("{kind}: {got:?} chi2 {:?} cells {}", r.chi2, r.global.cells);
         assert!(
@@ -102,6 +104,13 @@ fn many_distinct_points_give_the_certified_optimum_of_the_point_order_sums() {
                 p.best_fit
             );
         }
+    }
+    // All five together (one evaluator, the starting rows computed once and every row shared,
+    // the fits as tasks of the thread pool): each the same fit as alone, to the last bit.
+    let kinds = REFERENCE.map(|r| r.0);
+    let set = fit_all(&data, &kinds, &FitOptions::default()).unwrap();
+    for (together, alone) in set.fits.iter().zip(&alone) {
+        assert_eq!(together, alone, "{}", alone.model);
     }
 }
 

@@ -104,6 +104,17 @@ struct Axis {
 }
 
 impl Axis {
+    fn new(range: (f64, f64), n0: u64) -> Axis {
+        Axis {
+            lo: range.0,
+            hi: range.1,
+            n0: n0.max(1),
+            active: n0 > 0,
+            row_of: Map::default(),
+            t: Vec::new(),
+            ok: Vec::new(),
+        }
+    }
     fn span(&self) -> u64 {
         if self.active { self.n0 << DEPTH } else { 0 }
     }
@@ -191,22 +202,23 @@ pub struct Bnb<L: Landscape> {
     pub row_failures: Vec<String>,
 }
 
+/// The t of the starting grid's rows on an axis of `range` cut in `n0` cells, as [`Bnb::new`]
+/// asks the landscape for them (none for an inactive axis, `n0` = 0).
+pub fn starting_rows(range: (f64, f64), n0: u64) -> Vec<f64> {
+    let axis = Axis::new(range, n0);
+    if !axis.active {
+        return Vec::new();
+    }
+    (0..=n0).map(|i| axis.t_at(i << DEPTH)).collect()
+}
+
 impl<L: Landscape> Bnb<L> {
     /// A uniform starting grid of `n0[k]` cells over `range[k]` (an axis with `n0 = 0` is
     /// inactive: one row at its `lo`). Evaluates every starting node and cell bound.
     pub fn new(land: L, range: [(f64, f64); 2], n0: [u64; 2], limits: Limits) -> Self {
-        let axis = |k: usize| Axis {
-            lo: range[k].0,
-            hi: range[k].1,
-            n0: n0[k].max(1),
-            active: n0[k] > 0,
-            row_of: Map::default(),
-            t: Vec::new(),
-            ok: Vec::new(),
-        };
         let mut b = Bnb {
             land,
-            axes: [axis(0), axis(1)],
+            axes: [Axis::new(range[0], n0[0]), Axis::new(range[1], n0[1])],
             nodes: Map::default(),
             best: None,
             heap: BinaryHeap::new(),

@@ -42,10 +42,10 @@
 //! switched off ([`super::FitOptions::scan`]).
 
 use super::FitOptions;
-use super::bnb::{Bnb, Candidate, Landscape, Limits};
+use super::bnb::{Bnb, Candidate, Landscape, Limits, starting_rows};
 use super::kinks::{axis_stderr, kink_starts, polish_profiles};
 use super::landscape::{PowerLaw, Separable};
-use super::models::ModelKind;
+use super::models::{Evaluator, ModelKind};
 use super::objective::Objective;
 use super::polish::{Found, polish_brent, polish_lm, polish_newton, polish_valleys};
 use super::powerlaw::polish_powerlaw;
@@ -56,6 +56,8 @@ use crate::models::viscoelastic::VmMethod;
 /// tau = TAU_REL U + TAU_ABS s (see the module doc).
 pub const TAU_REL: f64 = 1e-7;
 pub const TAU_ABS: f64 = 1e-6;
+/// The separable models' starting grid: cells of log eta and of log sigma_y.
+const SEPARABLE_N0: [u64; 2] = [24, 16];
 /// Local polishes allowed per fit.
 const MAX_POLISH: u64 = 100;
 /// Local minima within this relative distance of the best are finished with line searches
@@ -78,6 +80,46 @@ pub struct SearchOutcome {
 /// part, as the module doc states it for the chi2 a user sees).
 pub fn tolerance(obj: &Objective, upper: f64) -> f64 {
     TAU_REL * (upper + obj.chi2_offset) + TAU_ABS * obj.scale(upper)
+}
+
+/// Computes the rows of the starting grids of the separable models among `kinds` ([`Evaluator::row`]):
+/// `vm`, `min` and `product` start from the same rows of e_vm, `pm`, `min` and `product` from
+/// the same rows of e_pm (the same boxes, the same cells). Done before their searches start
+/// side by side, each row is computed once (all of them in parallel) rather than once by each
+/// search that reaches it first; the searches' results do not change (a row is the same numbers
+/// whoever computes it). A box that cannot be built is left to the fits to report.
+pub fn share_starting_rows(ev: &Evaluator, kinds: &[ModelKind], options: &FitOptions) {
+    use rayon::prelude::*;
+    let uses = |k: usize| {
+        kinds
+            .iter()
+            .filter(|&&m| match m {
+                ModelKind::Vm => k == 0,
+                ModelKind::Pm => k == 1,
+                ModelKind::Min | ModelKind::Product => true,
+                ModelKind::PowerLaw => false,
+            })
+            .count()
+    };
+    if !options.scan {
+        return;
+    }
+    // The boxes of min and product: those of vm and of pm (search_box).
+    let Ok(obj) = Objective::new(ev, ModelKind::Min) else {
+        return;
+    };
+    let rows: Vec<(usize, f64)> = [0, 1]
+        .into_iter()
+        .filter(|&k| uses(k) >= 2)
+        .flat_map(|k| {
+            starting_rows((obj.lower[k], obj.upper[k]), SEPARABLE_N0[k])
+                .into_iter()
+                .map(move |t| (k, t))
+        })
+        .collect();
+    rows.par_iter().for_each(|&(k, t)| {
+        ev.row(k, t);
+    });
 }
 
 /// The global minimum (see the module doc).
@@ -128,10 +170,7 @@ pub fn global_minimum(obj: &Objective, options: &FitOptions) -> Result<SearchOut
             let active = [kind != ModelKind::Pm, kind != ModelKind::Vm];
             let land = Separable::new(obj, kind == ModelKind::Min, active);
             let range = [if active[0] { (el, eh) } else { (0.0, 0.0) }, (sl, sh)];
-            let n0 = [
-                if active[0] { 24 } else { 0 },
-                if active[1] { 16 } else { 0 },
-            ];
+            let n0 = [0, 1].map(|k| if active[k] { SEPARABLE_N0[k] } else { 0 });
             let bnb = Bnb::new(land, range, n0, limits);
             let to_theta = move |_: &Separable, _: [usize; 2], t: [f64; 2]| match kind {
                 ModelKind::Vm => vec![t[0]],

@@ -41,8 +41,9 @@ pub struct PowerLaw {
     m1: f64,
     m2: f64,
     a_range: (f64, f64),
-    /// Rows exp(-a c1_i) (axis 0) and exp(b c2_i) (axis 1), with their t.
-    rows: [Vec<f64>; 2],
+    /// Rows exp(-a c1_i) (axis 0) and exp(b c2_i) (axis 1), with their t (each row its own
+    /// allocation: one growing array was copied, and faulted in again, as it grew).
+    rows: [Vec<Vec<f64>>; 2],
     t: [Vec<f64>; 2],
     /// Sensitivity of chi2 to a and b: sqrt(sum w (c y)^2), with c the centred logarithm.
     sens: [f64; 2],
@@ -114,7 +115,7 @@ impl PowerLaw {
     }
 
     fn row(&self, k: usize, r: usize) -> &[f64] {
-        &self.rows[k][r * self.n..(r + 1) * self.n]
+        &self.rows[k][r]
     }
 
     /// ln of the factor between A and the centred amplitude: A_c = A exp(-a m1 + b m2).
@@ -169,7 +170,7 @@ impl Landscape for PowerLaw {
         let mut row = vec![0.0; self.n];
         sums::fill(&mut row, |i| (sign * t * c[i]).exp());
         let bad = row.iter().any(|z| !z.is_finite());
-        self.rows[axis].extend(row);
+        self.rows[axis].push(row);
         self.t[axis].push(t);
         if bad {
             return Err(format!(

@@ -4,6 +4,7 @@
 use super::super::bnb::{Bound, Landscape};
 use super::super::objective::Objective;
 use super::super::sums;
+use std::sync::Arc;
 
 mod cell;
 mod grid;
@@ -26,9 +27,11 @@ pub struct Separable<'a> {
     min_rule: bool,
     active: [bool; 2],
     n: usize,
-    /// Each row its own allocation: one growing array of every row was copied at each
-    /// reallocation and filled before being written (4% of a 100 000-point fit).
-    rows: [Vec<Vec<f64>>; 2],
+    /// Each row its own allocation (one growing array of every row was copied at each
+    /// reallocation and filled before being written: 4% of a 100 000-point fit), shared with
+    /// the other models fitted through the same evaluator
+    /// ([`crate::fit::models::Evaluator::row`]).
+    rows: [Vec<Arc<Vec<f64>>>; 2],
     t: [Vec<f64>; 2],
     e: Vec<f64>,
     w: Vec<f64>,
@@ -387,19 +390,15 @@ impl Separable<'_> {
         let (n, ev) = (self.n, self.obj.ev);
         self.t[axis].push(t);
         if !self.active[axis] {
-            self.rows[axis].push(vec![1.0; n]);
+            self.rows[axis].push(Arc::new(vec![1.0; n]));
             return Ok(());
         }
+        // Counted whether computed here or by another model's search (a fit's count of
+        // evaluations does not depend on which thread came first).
         self.obj.evals.set(self.obj.evals.get() + 1);
         let x = t.exp();
-        // Every value is written below (a failing one as NaN).
-        self.rows[axis].push(vec![0.0; n]);
-        let row = self.rows[axis].last_mut().expect("pushed");
-        if axis == 1 {
-            ev.e_pm_row(x, row);
-        } else {
-            ev.e_vm_row(x, row);
-        }
+        let row = ev.row(axis, t);
+        self.rows[axis].push(Arc::clone(&row));
         // The first point that failed names the failure (the evaluation's error if it gave
         // one, else the NaN).
         let Some(i) = row.iter().position(|v| v.is_nan()) else {
