@@ -13,7 +13,9 @@
 # system); with the master curve fed sorted kappas as vector operations and the sampled passes
 # over a contiguous copy 0.3-1.6 s; with the cell bound's sums in registers, nodes summed four
 # per vector lane, e_pm and the power law's exps four at a time and its linearised pass on
-# 256-bit lanes 0.3-1.5 s.
+# 256-bit lanes 0.3-1.5 s. `--model all` (timed since the seventh session): the five fits
+# side by side sharing one evaluator and its rows, 3.9-4.0 s of CPU and 2.2 s of wall time on
+# a busy spell of the host (the build before: 4.3-5.2 s, 2.6-3.0 s).
 #
 # Usage: bash scripts/time_big_fit.sh [BINARY]   (default target/release/restitution)
 set -euo pipefail
@@ -24,7 +26,7 @@ dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 python3 scripts/big_fit_data.py "$dir"
 for data in repeated distinct; do
-    for m in vm pm min product powerlaw; do
+    for m in vm pm min product powerlaw all; do
         /usr/bin/time -f "$data $m: %U s user + %S s system, %e s wall" \
             "$BIN" fit "$dir/$data.csv" --material nylon --model "$m" > /dev/null 2> "$dir/err" || true
         tail -1 "$dir/err"

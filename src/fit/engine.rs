@@ -245,7 +245,8 @@ pub struct FitSet {
 }
 
 /// Fits each model in `kinds` (skipping those with as many parameters as points, with an error
-/// if none is left), one thread per model, and compares them when there are two or more.
+/// if none is left), side by side through one evaluator of the points, and compares them when
+/// there are two or more. Each fit is the one [`fit`] gives alone, to the last bit.
 pub fn fit_all(data: &FitData, kinds: &[ModelKind], options: &FitOptions) -> Result<FitSet> {
     let (kinds, skipped): (Vec<ModelKind>, Vec<ModelKind>) =
         kinds.iter().partition(|k| data.len() > k.n_params());

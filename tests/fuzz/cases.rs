@@ -93,14 +93,7 @@ pub fn fit_case(rng: &mut StdRng, base: &Sheet, big_rows: bool) -> Case {
         }
     }
     let mutations = mutate(&mut sheet, rng, big_rows);
-    let many = sheet.rows.len() > 1000;
-    let model = if many {
-        // 100 000 rows: the one-parameter models (the two-parameter global scans are the
-        // engine's, and have their own cases below).
-        pick(rng, &["vm", "pm", "powerlaw"])
-    } else {
-        pick(rng, &["vm", "pm", "min", "product", "powerlaw", "all"])
-    };
+    let model = pick(rng, &["vm", "pm", "min", "product", "powerlaw", "all"]);
     let mut args = vec!["fit".into(), "data.csv".into()];
     args.extend(material(rng));
     args.extend(["--model".into(), model.clone()]);
