@@ -50,6 +50,7 @@ use super::objective::Objective;
 use super::polish::{Found, polish_brent, polish_lm, polish_newton, polish_valleys};
 use super::powerlaw::polish_powerlaw;
 use super::result::{GlobalSearch, show};
+use super::sums;
 use crate::error::{Error, Result};
 use crate::models::viscoelastic::VmMethod;
 
@@ -117,9 +118,16 @@ pub fn share_starting_rows(ev: &Evaluator, kinds: &[ModelKind], options: &FitOpt
                 .map(move |t| (k, t))
         })
         .collect();
-    rows.par_iter().for_each(|&(k, t)| {
-        ev.row(k, t);
-    });
+    // Small data on this thread: waking the pool costs more than their rows.
+    if sums::is_large(ev.len()) {
+        rows.par_iter().for_each(|&(k, t)| {
+            ev.row(k, t);
+        });
+    } else {
+        for &(k, t) in &rows {
+            ev.row(k, t);
+        }
+    }
 }
 
 /// The global minimum (see the module doc).
