@@ -257,13 +257,6 @@ pub fn fit_all(data: &FitData, kinds: &[ModelKind], options: &FitOptions) -> Res
             expected: "more points than the model has parameters",
         });
     }
-    // The models are independent: fit them side by side (results do not depend on the number
-    // of threads; each fit is deterministic). One model runs here: a thread would only add its
-    // start-up to the main job's whole-process time. Large data's fits sum on the rayon pool
-    // ([`sums`]), so they run as its tasks: on threads of their own, five fits and the pool's
-    // workers took turns on the cores, every sum a hand-over between threads (a tenth more CPU,
-    // a fifth more wall time on two cores). Small data never wake the pool (its idle workers'
-    // spinning cost more than the fits' threads).
     // Repeated (d, d2, v) rows cost the search their count but change chi2 only by a constant:
     // merged once, and the points' evaluator built once, for every model.
     let merged = data.merge_repeats();
@@ -273,6 +266,13 @@ pub fn fit_all(data: &FitData, kinds: &[ModelKind], options: &FitOptions) -> Res
         share_starting_rows(&ev, &kinds, options);
     }
     let (merged, ev) = (merged.as_ref(), &ev);
+    // The models are independent: fit them side by side (results do not depend on the number
+    // of threads; each fit is deterministic). One model runs here: a thread would only add its
+    // start-up to the main job's whole-process time. Large data's fits sum on the rayon pool
+    // ([`sums`]), so they run as its tasks: on threads of their own, five fits and the pool's
+    // workers took turns on the cores, every sum a hand-over between threads (a tenth more CPU,
+    // a fifth more wall time on two cores). Small data never wake the pool (its idle workers'
+    // spinning cost more than the fits' threads).
     let fits = if let [k] = kinds[..] {
         vec![fit_points(data, merged, ev, k, options)?]
     } else if sums::is_large(points.len()) {
