@@ -276,9 +276,13 @@ pub fn fit_all(data: &FitData, kinds: &[ModelKind], options: &FitOptions) -> Res
     let fits = if let [k] = kinds[..] {
         vec![fit_points(data, merged, ev, k, options)?]
     } else if sums::is_large(points.len()) {
+        // Every fit's outcome first, then the first error in the models' order (rayon's own
+        // collect into a Result returns whichever error it meets first: not reproducible).
         kinds
             .par_iter()
             .map(|&k| fit_points(data, merged, ev, k, options))
+            .collect::<Vec<_>>()
+            .into_iter()
             .collect::<Result<Vec<_>>>()?
     } else {
         std::thread::scope(|s| {
