@@ -108,7 +108,7 @@ fn fit_points(
         obj = obj.with_merged(m);
     }
     let search = global_minimum(&obj, options)?;
-    let fit_evals = obj.evals.get();
+    let fit_evals = obj.evaluations();
     let SearchOutcome {
         mut best,
         global,
@@ -164,7 +164,7 @@ fn fit_points(
         }
     }
     let lost_intervals = options.intervals && profiles.is_none();
-    let profile_evals = obj.evals.get() - fit_evals;
+    let profile_evals = obj.evaluations() - fit_evals;
     let rows = Rows { data, merged };
     let mut r = summarise(
         &obj,

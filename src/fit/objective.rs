@@ -25,7 +25,7 @@ use super::models::{Evaluator, ModelKind, POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S,
 use crate::error::{Error, Result};
 use crate::models::viscoelastic::{Integrator, VmMethod, master::KAPPA_MAX};
 use nalgebra::DMatrix;
-use std::cell::Cell;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 /// chi2 quantile of one degree of freedom at 95% (the profile-likelihood interval threshold).
 pub const CHI2_1DOF_95: f64 = 3.841458820694124;
@@ -41,7 +41,8 @@ pub struct Objective<'a> {
     pub lower: Vec<f64>,
     pub upper: Vec<f64>,
     pub fd_step: f64,
-    pub evals: Cell<u64>,
+    /// Evaluations of the model over every point (atomic: a fit's profiles run side by side).
+    pub evals: AtomicU64,
     pub inv_sigma: Vec<f64>,
     /// The points' measured e, contiguous.
     e: Vec<f64>,
@@ -67,7 +68,7 @@ impl Residuals for Objective<'_> {
         self.ev.len()
     }
     fn residuals(&self, theta: &[f64], out: &mut [f64]) -> Result<()> {
-        self.evals.set(self.evals.get() + 1);
+        self.count_evaluation();
         let p = self.kind.to_physical(theta);
         let (e, inv_sigma) = (&self.e[..], &self.inv_sigma[..]);
         self.ev.predict_then(self.kind, &p, out, |start, slots| {
@@ -119,7 +120,7 @@ impl Residuals for Objective<'_> {
         if !self.ev.has_exact_jacobian(k) || !free.contains(&true) {
             return None;
         }
-        self.evals.set(self.evals.get() + 1);
+        self.count_evaluation();
         let p = k.to_physical(theta);
         Some(self.ev.jacobian_separable_with(
             k,
@@ -133,6 +134,16 @@ impl Residuals for Objective<'_> {
 }
 
 impl<'a> Objective<'a> {
+    /// Counts one evaluation of the model over every point.
+    pub fn count_evaluation(&self) {
+        self.evals.fetch_add(1, Ordering::Relaxed);
+    }
+
+    /// Evaluations so far.
+    pub fn evaluations(&self) -> u64 {
+        self.evals.load(Ordering::Relaxed)
+    }
+
     /// The problem of `kind` on the evaluator's data, with its search box.
     pub fn new(ev: &'a Evaluator<'a>, kind: ModelKind) -> Result<Objective<'a>> {
         let data = ev.data;
@@ -152,7 +163,7 @@ impl<'a> Objective<'a> {
             lower,
             upper,
             fd_step: fd_step_for(kind, &ev.method),
-            evals: Cell::new(0),
+            evals: AtomicU64::new(0),
             inv_sigma,
             e: data.obs.iter().map(|o| o.e).collect(),
             e_accuracy: model_accuracy(&ev.method),

@@ -22,6 +22,7 @@
 use super::lsq::{self, Covariance, LmOptions, Residuals};
 use super::objective::{CHI2_1DOF_95, Objective};
 use super::scalar::{Crossing, profile_crossing};
+use super::sums;
 use crate::error::Result;
 use std::cell::{Cell, RefCell};
 
@@ -64,7 +65,7 @@ pub fn profile_intervals(
 
 /// As [`profile_intervals`] for any problem, with the chi2 scale given.
 pub fn profile_intervals_of(
-    obj: &impl Residuals,
+    obj: &(impl Residuals + Sync),
     theta: &[f64],
     chi2_min: f64,
     cov: &Covariance,
@@ -72,73 +73,110 @@ pub fn profile_intervals_of(
 ) -> Result<ProfileOutcome> {
     let k = obj.n_params();
     let delta = CHI2_1DOF_95 * scale;
-    let threshold = chi2_min + delta;
-    // A profile point this far below the minimum means a missed minimum, not rounding.
-    let beaten = chi2_min - 1e-7 * chi2_min.abs().max(1.0);
-    let mut sides = Vec::with_capacity(k);
-    let mut unconverged = Vec::with_capacity(k);
-    let lm = LmOptions::default();
-    let (lower, upper) = (obj.lower(), obj.upper());
-    for j in 0..k {
-        if cov.degenerate[j] {
-            // Only a combination with other parameters is determined; a profile would end only
-            // at the edges of the other parameters' search ranges.
-            sides.push([Side::Open, Side::Open]);
-            unconverged.push(0);
-            continue;
-        }
-        let span = upper[j] - lower[j];
-        let step = (delta * cov.matrix[(j, j)]).sqrt();
-        let step = if step.is_finite() && step > 0.0 {
-            step.min(0.25 * span)
-        } else {
-            0.01 * span
-        };
-        let failed_inner = Cell::new(0u32);
-        let mut pair = [Side::Open, Side::Open];
-        for (s, limit) in [lower[j], upper[j]].into_iter().enumerate() {
-            let warm = RefCell::new(vec![(theta[j], theta.to_vec())]);
-            let lower_found = RefCell::new(None::<Vec<f64>>);
-            let profile = |t: f64| -> Result<f64> {
-                let mut start =
-                    warm_start(&warm.borrow(), t, lower, upper).unwrap_or_else(|| theta.to_vec());
-                start[j] = t;
-                let (c, th) = if k == 1 {
-                    (lsq::chi2(obj, &start)?, start)
-                } else {
-                    let mut free = vec![true; k];
-                    free[j] = false;
-                    let r = lsq::levenberg_marquardt(obj, &start, &free, &lm)?;
-                    if !r.converged {
-                        failed_inner.set(failed_inner.get() + 1);
-                    }
-                    (r.chi2, r.theta)
-                };
-                if c < beaten && lower_found.borrow().is_none() {
-                    *lower_found.borrow_mut() = Some(th.clone());
-                }
-                warm.borrow_mut().push((t, th));
-                Ok(c)
-            };
-            // Crossings to 1e-7 in the internal coordinate (log parameters: 1e-7 relative).
-            let c = profile_crossing(profile, theta[j], chi2_min, limit, step, threshold, 1e-7)?;
-            if let Some(t) = lower_found.into_inner() {
-                return Ok(ProfileOutcome::Lower(t));
+    // Degenerate parameters: only a combination with other parameters is determined; a profile
+    // would end only at the edges of the other parameters' search ranges.
+    let ends: Vec<(usize, usize)> = (0..k)
+        .filter(|&j| !cov.degenerate[j])
+        .flat_map(|j| [(j, 0), (j, 1)])
+        .collect();
+    let end = |&(j, s): &(usize, usize)| profile_end(obj, theta, chi2_min, cov, delta, j, s);
+    // Each end is its own profile (warm-started from its own points only), so large data's
+    // ends run side by side (a fit's profiles are a fifth of its time, and the last fit of
+    // `--model all` otherwise runs its profiles on one core while the other waits) and give
+    // the same numbers as one after another. Small data's stay on this thread.
+    let found: Vec<Result<End>> = if sums::is_large(obj.n_residuals()) {
+        use rayon::prelude::*;
+        ends.par_iter().map(end).collect()
+    } else {
+        ends.iter().map(end).collect()
+    };
+    let mut sides = vec![[Side::Open, Side::Open]; k];
+    let mut unconverged = vec![0; k];
+    // In the ends' order, as one after another would stop: at the first error or lower
+    // minimum.
+    for (&(j, s), f) in ends.iter().zip(found) {
+        match f? {
+            End::Lower(t) => return Ok(ProfileOutcome::Lower(t)),
+            End::Side(side, failed) => {
+                sides[j][s] = side;
+                unconverged[j] += failed;
             }
-            pair[s] = match c {
-                Crossing::At(t) => Side::At(t),
-                Crossing::Open => Side::Open,
-                Crossing::Failed(why) => Side::Lost(why),
-            };
         }
-        sides.push(pair);
-        unconverged.push(failed_inner.get());
     }
     Ok(ProfileOutcome::Done(Profiles {
         sides,
         unconverged,
         delta,
     }))
+}
+
+/// What the profile of one end of one parameter found.
+enum End {
+    /// The end, and the inner minimisations that did not converge.
+    Side(Side, u32),
+    /// A point below the minimum.
+    Lower(Vec<f64>),
+}
+
+/// The end `s` (0 lower, 1 upper) of parameter j's interval (see the module doc).
+fn profile_end(
+    obj: &impl Residuals,
+    theta: &[f64],
+    chi2_min: f64,
+    cov: &Covariance,
+    delta: f64,
+    j: usize,
+    s: usize,
+) -> Result<End> {
+    let k = obj.n_params();
+    let threshold = chi2_min + delta;
+    // A profile point this far below the minimum means a missed minimum, not rounding.
+    let beaten = chi2_min - 1e-7 * chi2_min.abs().max(1.0);
+    let lm = LmOptions::default();
+    let (lower, upper) = (obj.lower(), obj.upper());
+    let span = upper[j] - lower[j];
+    let step = (delta * cov.matrix[(j, j)]).sqrt();
+    let step = if step.is_finite() && step > 0.0 {
+        step.min(0.25 * span)
+    } else {
+        0.01 * span
+    };
+    let limit = [lower[j], upper[j]][s];
+    let failed_inner = Cell::new(0u32);
+    let warm = RefCell::new(vec![(theta[j], theta.to_vec())]);
+    let lower_found = RefCell::new(None::<Vec<f64>>);
+    let profile = |t: f64| -> Result<f64> {
+        let mut start =
+            warm_start(&warm.borrow(), t, lower, upper).unwrap_or_else(|| theta.to_vec());
+        start[j] = t;
+        let (c, th) = if k == 1 {
+            (lsq::chi2(obj, &start)?, start)
+        } else {
+            let mut free = vec![true; k];
+            free[j] = false;
+            let r = lsq::levenberg_marquardt(obj, &start, &free, &lm)?;
+            if !r.converged {
+                failed_inner.set(failed_inner.get() + 1);
+            }
+            (r.chi2, r.theta)
+        };
+        if c < beaten && lower_found.borrow().is_none() {
+            *lower_found.borrow_mut() = Some(th.clone());
+        }
+        warm.borrow_mut().push((t, th));
+        Ok(c)
+    };
+    // Crossings to 1e-7 in the internal coordinate (log parameters: 1e-7 relative).
+    let c = profile_crossing(profile, theta[j], chi2_min, limit, step, threshold, 1e-7)?;
+    if let Some(t) = lower_found.into_inner() {
+        return Ok(End::Lower(t));
+    }
+    let side = match c {
+        Crossing::At(t) => Side::At(t),
+        Crossing::Open => Side::Open,
+        Crossing::Failed(why) => Side::Lost(why),
+    };
+    Ok(End::Side(side, failed_inner.get()))
 }
 
 /// The start of the inner minimisation at t: the other parameters on the line through the two
@@ -225,15 +263,28 @@ mod tests {
 
     #[test]
     fn a_lines_profile_interval_is_its_closed_form() {
-        let x: Vec<f64> = (0..10).map(|i| i as f64).collect();
+        // 10 points: the ends one after another on this thread.
+        line_intervals_are_the_closed_form(10);
+    }
+
+    #[test]
+    fn a_lines_profile_interval_is_its_closed_form_with_the_ends_side_by_side() {
+        // Large data (sums::is_large): the four ends run side by side on the pool.
+        let n = sums::PARALLEL_MIN_POINTS + 1000;
+        assert!(sums::is_large(n));
+        line_intervals_are_the_closed_form(n);
+    }
+
+    fn line_intervals_are_the_closed_form(n: usize) {
+        let x: Vec<f64> = (0..n).map(|i| (i % 10) as f64).collect();
         let y: Vec<f64> = x
             .iter()
             .enumerate()
             .map(|(i, &x)| 1.0 + 0.5 * x + [0.3, -0.2, 0.1, -0.4, 0.2][i % 5])
             .collect();
         // Closed-form least squares: slope = Sxy/Sxx, var(slope) = 1/Sxx (sigma = 1).
-        let n = x.len() as f64;
-        let (mx, my) = (x.iter().sum::<f64>() / n, y.iter().sum::<f64>() / n);
+        let nf = n as f64;
+        let (mx, my) = (x.iter().sum::<f64>() / nf, y.iter().sum::<f64>() / nf);
         let sxx: f64 = x.iter().map(|x| (x - mx).powi(2)).sum();
         let sxy: f64 = x.iter().zip(&y).map(|(x, y)| (x - mx) * (y - my)).sum();
         let slope = sxy / sxx;
@@ -245,7 +296,7 @@ mod tests {
             hi: vec![100.0, 100.0],
         };
         let chi2 = lsq::chi2(&p, &[c0, slope]).unwrap();
-        let mut f0 = vec![0.0; 10];
+        let mut f0 = vec![0.0; n];
         p.residuals(&[c0, slope], &mut f0).unwrap();
         let cov = lsq::covariance(&lsq::jacobian(&p, &[c0, slope], &[true, true], &f0).unwrap());
         let out = profile_intervals_of(&p, &[c0, slope], chi2, &cov, 1.0).unwrap();
@@ -262,8 +313,11 @@ mod tests {
             other => panic!("{other:?}"),
         }
         assert_eq!(pr.unconverged, vec![0, 0]);
-        // Started from a point that is not the minimum, a profile finds a lower one.
-        let off = profile_intervals_of(&p, &[c0 + 0.5, slope], chi2 + 2.5, &cov, 1.0).unwrap();
+        // Started two standard errors of c0 from the minimum (chi2 4 above it, for a line
+        // exactly), a profile finds a lower point (at one standard error it is 1 above).
+        let sd0 = cov.matrix[(0, 0)].sqrt();
+        let off =
+            profile_intervals_of(&p, &[c0 + 2.0 * sd0, slope], chi2 + 4.0, &cov, 1.0).unwrap();
         assert!(matches!(off, ProfileOutcome::Lower(_)), "{off:?}");
     }
 }

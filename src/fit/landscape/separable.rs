@@ -395,7 +395,7 @@ impl Separable<'_> {
         }
         // Counted whether computed here or by another model's search (a fit's count of
         // evaluations does not depend on which thread came first).
-        self.obj.evals.set(self.obj.evals.get() + 1);
+        self.obj.count_evaluation();
         let x = t.exp();
         let row = ev.row(axis, t);
         self.rows[axis].push(Arc::clone(&row));
