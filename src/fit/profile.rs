@@ -146,8 +146,12 @@ fn profile_end(
     let warm = RefCell::new(vec![(theta[j], theta.to_vec())]);
     let lower_found = RefCell::new(None::<Vec<f64>>);
     let profile = |t: f64| -> Result<f64> {
-        let mut start =
-            warm_start(&warm.borrow(), t, lower, upper).unwrap_or_else(|| theta.to_vec());
+        let mut start = match &warm.borrow()[..] {
+            // Only the minimum so far: along the covariance's valley (exact for a quadratic).
+            [_] => along_covariance(theta, cov, j, t, lower, upper),
+            w => warm_start(w, t, lower, upper),
+        }
+        .unwrap_or_else(|| theta.to_vec());
         start[j] = t;
         let (c, th) = if k == 1 {
             (lsq::chi2(obj, &start)?, start)
@@ -177,6 +181,38 @@ fn profile_end(
         Crossing::Failed(why) => Side::Lost(why),
     };
     Ok(End::Side(side, failed_inner.get()))
+}
+
+/// The start of the inner minimisation at t when only the minimum is known: the other
+/// parameters where the quadratic approximation of chi2 at the minimum has its least value with
+/// theta_j = t, theta_k + (C_kj / C_jj)(t - theta_j) (the regression of theta_k on theta_j under
+/// the covariance C), kept in the box. From the minimum itself the first profile point took
+/// Levenberg-Marquardt four to six iterations on the fits of 100 000 points; the later ones,
+/// warm-started along the profile, one. None if C_jj is not a positive number.
+fn along_covariance(
+    theta: &[f64],
+    cov: &Covariance,
+    j: usize,
+    t: f64,
+    lower: &[f64],
+    upper: &[f64],
+) -> Option<Vec<f64>> {
+    let cjj = cov.matrix[(j, j)];
+    if !(cjj > 0.0 && cjj.is_finite()) {
+        return None;
+    }
+    Some(
+        (0..theta.len())
+            .map(|k| {
+                let x = theta[k] + cov.matrix[(k, j)] / cjj * (t - theta[j]);
+                if x.is_finite() {
+                    x.max(lower[k]).min(upper[k])
+                } else {
+                    theta[k]
+                }
+            })
+            .collect(),
+    )
 }
 
 /// The start of the inner minimisation at t: the other parameters on the line through the two
@@ -259,6 +295,42 @@ mod tests {
         let twice = vec![(1.0, vec![1.0, 3.0]), (1.0, vec![1.0, 4.0])];
         assert_eq!(warm_start(&twice, 2.0, &lo, &hi), Some(vec![1.0, 3.0]));
         assert_eq!(warm_start(&[], 2.0, &lo, &hi), None);
+    }
+
+    #[test]
+    fn the_first_start_follows_the_covariance() {
+        use nalgebra::DMatrix;
+        let cov = |m: [f64; 4]| Covariance {
+            matrix: DMatrix::from_row_slice(2, 2, &m),
+            no_effect: vec![false; 2],
+            degenerate: vec![false; 2],
+        };
+        let (lo, hi) = ([-10.0, -10.0], [10.0, 10.0]);
+        // C_10 / C_00 = 0.5: theta_1 moves half as far as theta_0 (binary fractions: exact).
+        let c = cov([4.0, 2.0, 2.0, 3.0]);
+        assert_eq!(
+            along_covariance(&[1.0, 2.0], &c, 0, 3.0, &lo, &hi),
+            Some(vec![3.0, 3.0])
+        );
+        // Profiling theta_1: C_01 / C_11 = 2/3 of its move.
+        assert_eq!(
+            along_covariance(&[1.0, 2.0], &c, 1, 5.0, &lo, &hi),
+            Some(vec![3.0, 5.0])
+        );
+        // Kept in the box; no start without a positive variance; NaN entries stay put.
+        assert_eq!(
+            along_covariance(&[1.0, 2.0], &c, 0, 41.0, &lo, &hi),
+            Some(vec![10.0, 10.0])
+        );
+        assert_eq!(
+            along_covariance(&[1.0, 2.0], &cov([0.0, 0.0, 0.0, 1.0]), 0, 3.0, &lo, &hi),
+            None
+        );
+        let nan = cov([4.0, f64::NAN, f64::NAN, 3.0]);
+        assert_eq!(
+            along_covariance(&[1.0, 2.0], &nan, 0, 3.0, &lo, &hi),
+            Some(vec![3.0, 2.0])
+        );
     }
 
     #[test]
