@@ -349,3 +349,62 @@ fn three_d_and_wall_collisions_fit_end_to_end() {
     assert!((v["mu0"]["value"].as_f64().unwrap() - 0.3).abs() < 1e-12);
     assert_eq!(v["e"]["ci95"], serde_json::Value::Null);
 }
+
+#[test]
+fn json_collisions_keep_their_keys_in_order_and_null_where_there_is_no_number() {
+    // The shipped collisions and a head-on one (no tangential speed: beta and psi have no
+    // value), its id with a comma and quotes.
+    let dir = scratch("json-keys");
+    let path = dir.join("c.csv");
+    let mut text = std::fs::read_to_string(shipped()).unwrap();
+    text += "\"head, \"\"on\"\"\",25.4,25.4,0,0,0.0254,0,1,0,0,-1,0,0,-0.9,0,0,0.9,0,0\n";
+    std::fs::write(&path, text).unwrap();
+    let (ok, out, err) = run(&[
+        "walton",
+        "fit",
+        path.to_str().unwrap(),
+        "--material",
+        "nylon",
+        "--format",
+        "json",
+    ]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let keys: Vec<&String> = v.as_object().unwrap().keys().collect();
+    assert_eq!(keys.last().map(|k| k.as_str()), Some("collisions"));
+    let all = v["collisions"].as_array().unwrap();
+    assert_eq!(all.len(), 61);
+    let head_on = &all[60];
+    let keys: Vec<&str> = head_on
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(|k| k.as_str())
+        .collect();
+    assert_eq!(
+        keys,
+        [
+            "line",
+            "collision",
+            "e",
+            "beta",
+            "psi",
+            "v_n_m_s",
+            "v_s_m_s",
+            "impulse_ratio",
+            "class",
+            "residual"
+        ]
+    );
+    assert_eq!(head_on["collision"], "head, \"on\"");
+    assert_eq!(head_on["class"], "head_on");
+    assert!(
+        head_on["beta"].is_null() && head_on["psi"].is_null(),
+        "{head_on}"
+    );
+    assert!(
+        (head_on["e"].as_f64().unwrap() - 0.9).abs() < 1e-12,
+        "{head_on}"
+    );
+    assert!(all[0]["psi"].is_f64() && all[0]["beta"].is_f64());
+}
