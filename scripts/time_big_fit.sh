@@ -15,7 +15,9 @@
 # per vector lane, e_pm and the power law's exps four at a time and its linearised pass on
 # 256-bit lanes 0.3-1.5 s. `--model all` (timed since the seventh session): the five fits
 # side by side sharing one evaluator and its rows, 3.9-4.0 s of CPU and 2.15-2.19 s of wall
-# time on a busy spell of the host (the build before: 5.0-5.2 s, 2.9-3.0 s in that spell).
+# time on a busy spell of the host (the build before: 5.0-5.2 s, 2.9-3.0 s in that spell);
+# with the profiles' ends side by side and Levenberg-Marquardt's sums on both cores (eighth
+# session) 3.7-4.0 s and 2.15-2.34 s in another slow spell (0.97 of the wall time before).
 #
 # Usage: bash scripts/time_big_fit.sh [BINARY]   (default target/release/restitution)
 set -euo pipefail

@@ -208,7 +208,7 @@ fn fig7_rows_distinct(n: usize) -> Vec<u8> {
 /// one-parameter models 0.3-0.4 s of CPU, `min` 0.8-1.1 s, `product` 1.2-1.5 s and `powerlaw`
 /// 1.2-1.6 s (user + system; `product` 1.3-1.6 s and `powerlaw` 1.2-1.4 s with one of the two
 /// cores kept busy by another process). `--model all` on distinct points takes the five fits'
-/// CPU together, less the rows they share (3.9-4.1 s on the two cores, 2.2-2.3 s of wall
+/// CPU together, less the rows they share (3.7-4.0 s on the two cores, 2.0-2.3 s of wall
 /// time): beyond the limit, so not a case here (README, known limitations).
 #[test]
 fn hundred_thousand_rows_fit() {
