@@ -100,8 +100,9 @@ pub fn chi2(p: &impl Residuals, theta: &[f64]) -> Result<f64> {
 }
 
 /// sum f_i^2: in order for small data (as it always was), by chunks for large data
-/// ([`sums::sum`]: the serial sums of Levenberg-Marquardt were a tenth of a 100 000-point fit's
-/// time, and the whole of it while the last fit of `--model all` ran alone).
+/// ([`sums::sum`]: the serial sums of Levenberg-Marquardt were about a twentieth of
+/// `fit --model all` on 100 000 points, and the whole of its tail while its last fit ran
+/// alone).
 fn sum_squares(f: &[f64]) -> f64 {
     if !sums::is_large(f.len()) {
         return f.iter().map(|x| x * x).sum();

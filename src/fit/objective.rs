@@ -41,8 +41,9 @@ pub struct Objective<'a> {
     pub lower: Vec<f64>,
     pub upper: Vec<f64>,
     pub fd_step: f64,
-    /// Evaluations of the model over every point (atomic: a fit's profiles run side by side).
-    pub evals: AtomicU64,
+    /// Evaluations of the model over every point (atomic: a fit's profiles run side by side;
+    /// [`Objective::count_evaluation`], [`Objective::evaluations`]).
+    evals: AtomicU64,
     pub inv_sigma: Vec<f64>,
     /// The points' measured e, contiguous.
     e: Vec<f64>,

@@ -205,11 +205,7 @@ fn along_covariance(
         (0..theta.len())
             .map(|k| {
                 let x = theta[k] + cov.matrix[(k, j)] / cjj * (t - theta[j]);
-                if x.is_finite() {
-                    x.max(lower[k]).min(upper[k])
-                } else {
-                    theta[k]
-                }
+                kept_in_box(x, lower[k], upper[k], theta[k])
             })
             .collect(),
     )
@@ -229,16 +225,18 @@ fn warm_start(warm: &[(f64, Vec<f64>)], t: f64, lower: &[f64], upper: &[f64]) ->
     let s = (t - t1) / (t2 - t1);
     Some(
         (0..th1.len())
-            .map(|k| {
-                let x = th1[k] + s * (th2[k] - th1[k]);
-                if x.is_finite() {
-                    x.max(lower[k]).min(upper[k])
-                } else {
-                    th1[k]
-                }
-            })
+            .map(|k| kept_in_box(th1[k] + s * (th2[k] - th1[k]), lower[k], upper[k], th1[k]))
             .collect(),
     )
+}
+
+/// x kept in [lo, hi]; `fallback` where x is not a number (a start must be finite).
+fn kept_in_box(x: f64, lo: f64, hi: f64, fallback: f64) -> f64 {
+    if x.is_finite() {
+        x.max(lo).min(hi)
+    } else {
+        fallback
+    }
 }
 
 #[cfg(test)]

@@ -417,3 +417,38 @@ pub fn render_markdown(fit: &WaltonFit, ctx: &Context) -> String {
           s = mu0 (1 + 1/K)(1 + e) (Eq. 7); psi = -v_n/|v_s|.\n";
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_collision_without_a_number_writes_null_and_the_collisions_come_last() {
+        // As `json!` did: a non-finite number is null, never NaN or inf in the JSON.
+        let id = Some("a, \"b\"".to_string());
+        let row = CollisionJson {
+            line: 7,
+            collision: &id,
+            e: f64::NAN,
+            beta: Some(f64::INFINITY),
+            psi: None,
+            v_n_m_s: 1.5,
+            v_s_m_s: 0.0,
+            impulse_ratio: f64::NEG_INFINITY,
+            class: "head_on",
+            residual: Some(0.25),
+        };
+        let head = json!({"n": 1, "message": "ok"});
+        let text = serde_json::to_string(&ReportJson {
+            head: &head,
+            collisions: vec![row],
+        })
+        .unwrap();
+        assert_eq!(
+            text,
+            "{\"n\":1,\"message\":\"ok\",\"collisions\":[{\"line\":7,\"collision\":\"a, \\\"b\\\"\",\
+             \"e\":null,\"beta\":null,\"psi\":null,\"v_n_m_s\":1.5,\"v_s_m_s\":0.0,\
+             \"impulse_ratio\":null,\"class\":\"head_on\",\"residual\":0.25}]}"
+        );
+    }
+}
