@@ -180,6 +180,49 @@ mod tests {
     }
 
     #[test]
+    fn power_law_nodes_are_the_profile_over_a_computed_from_the_model() {
+        // A node's (ln A, chi2) against ProfiledPowerLaw's least-squares A (its own exps and
+        // sums) and lsq::chi2 there (the model itself): small data (sums in one run) and large
+        // (chunks, each with a remainder past its groups of four), exponents across the box.
+        // 1e-12 relative: the two sides form the same sums in different orders and forms.
+        let base = data();
+        let n = crate::fit::sums::PARALLEL_MIN_POINTS + 1003;
+        let obs = (0..n)
+            .map(|k| {
+                let mut o = base.obs[k % base.obs.len()];
+                o.v_n_m_s *= 1.0 + 1e-3 * ((k * 7919 % 2001) as f64 / 1000.0 - 1.0);
+                o
+            })
+            .collect();
+        let large = FitData::new(base.material, obs).unwrap();
+        for d in [base, large] {
+            let ev = Evaluator::new(&d, ContactEnd::Overlap, VmMethod::Master);
+            let obj = Objective::new(&ev, ModelKind::PowerLaw).unwrap();
+            let profiled = super::super::powerlaw::ProfiledPowerLaw::new(&obj);
+            let mut l = PowerLaw::new(&obj);
+            let ab = [[0.4, 0.5], [-1.0, 2.0], [2.5, -0.5], [0.0, 0.0], [6.0, 3.0]];
+            for (k, t) in ab.iter().enumerate() {
+                l.add_row(0, t[0]).unwrap();
+                l.add_row(1, t[1]).unwrap();
+                let (ln_a, chi2) = l.profile([k, k]);
+                let want_ln_a = profiled.ln_a(t);
+                let want = lsq::chi2(&obj, &[want_ln_a, t[0], t[1]]).unwrap();
+                let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * b.abs().max(1.0);
+                assert!(
+                    close(ln_a, want_ln_a),
+                    "{} {t:?}: ln A {ln_a} vs {want_ln_a}",
+                    d.len()
+                );
+                assert!(
+                    close(chi2, want),
+                    "{} {t:?}: chi2 {chi2} vs {want}",
+                    d.len()
+                );
+            }
+        }
+    }
+
+    #[test]
     fn large_data_bounds_are_below_chi2_everywhere_in_their_cells() {
         // Above the parallel threshold the sums are chunked and the power law's bound starts
         // from inside its box (powerlaw.rs): the same check on the 40-point pattern repeated

@@ -44,6 +44,8 @@ pub struct PowerLaw {
     /// Rows exp(-a c1_i) (axis 0) and exp(b c2_i) (axis 1), with their t (each row its own
     /// allocation: one growing array was copied, and faulted in again, as it grew).
     rows: [Vec<Vec<f64>>; 2],
+    /// Each row's largest value (the scale of [`PowerLaw::profile`]'s sums).
+    row_max: [Vec<f64>; 2],
     t: [Vec<f64>; 2],
     /// Sensitivity of chi2 to a and b: sqrt(sum w (c y)^2), with c the centred logarithm.
     sens: [f64; 2],
@@ -106,6 +108,7 @@ impl PowerLaw {
             m2,
             a_range: (obj.lower[0].exp(), obj.upper[0].exp()),
             rows: [Vec::new(), Vec::new()],
+            row_max: [Vec::new(), Vec::new()],
             t: [Vec::new(), Vec::new()],
             bound_tol: 0.0,
             scratch: RefCell::new([vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]]),
@@ -123,26 +126,30 @@ impl PowerLaw {
         -a * self.m1 + b * self.m2
     }
 
-    /// The exact minimum over A (in its box) at the node: (ln A, chi2).
+    /// The exact minimum over A (in its box) at the node: (ln A, chi2). Two passes over the
+    /// points, each summed in four lanes (the k-th point of a chunk in lane k mod 4, the lanes
+    /// added as (l0 + l1) + (l2 + l3); no padding).
     pub fn profile(&self, r: [usize; 2]) -> (f64, f64) {
         let (za, zb) = (self.row(0, r[0]), self.row(1, r[1]));
         let (a, b) = (self.t[0][r[0]], self.t[1][r[1]]);
-        // Least squares in A_c with z and w scaled by their maxima (no overflow in the sums).
-        let zmax = (0..self.n).map(|i| za[i] * zb[i]).fold(0.0, f64::max);
+        // Least squares in A_c with each row scaled by its largest value and w by its own: no
+        // overflow in the sums (a scaled z is at most 1, to rounding). A row of zeros (every
+        // exponential underflowed) gives NaN sums, hence A at the end of its box, as before.
+        let (sa, sb) = (1.0 / self.row_max[0][r[0]], 1.0 / self.row_max[1][r[1]]);
         let (y, ws) = (&self.y[..], &self.w_scaled[..]);
         let [num, den] = sums::sum(self.n, |points| {
-            let (mut num, mut den) = (0.0, 0.0);
-            for i in points {
-                let z = za[i] * zb[i] / zmax;
-                let w = ws[i];
-                num += w * z * y[i];
-                den += w * z * z;
-            }
-            [num, den]
+            let (mut num, mut den) = ([0.0; 4], [0.0; 4]);
+            lanes::each(points, |l, i| {
+                let z = (za[i] * sa) * (zb[i] * sb);
+                let wz = ws[i] * z;
+                num[l] += wz * y[i];
+                den[l] += wz * z;
+            });
+            [lanes::total_of(num), lanes::total_of(den)]
         });
         let s = self.shift(a, b);
         let (lo, hi) = (self.a_range.0 * s.exp(), self.a_range.1 * s.exp());
-        let ac = num / den / zmax;
+        let ac = num / den * sa * sb;
         let ac = if ac.is_nan() || ac < lo {
             lo
         } else if ac > hi {
@@ -152,12 +159,12 @@ impl PowerLaw {
         };
         let w = &self.w[..];
         let [chi2] = sums::sum(self.n, |points| {
-            let mut chi2 = 0.0;
-            for i in points {
+            let mut chi2 = [0.0; 4];
+            lanes::each(points, |l, i| {
                 let d = ac * za[i] * zb[i] - y[i];
-                chi2 += w[i] * d * d;
-            }
-            [chi2]
+                chi2[l] += w[i] * d * d;
+            });
+            [lanes::total_of(chi2)]
         });
         (ac.ln() - s, chi2)
     }
@@ -169,7 +176,10 @@ impl Landscape for PowerLaw {
         let sign = if axis == 0 { -1.0 } else { 1.0 };
         let mut row = vec![0.0; self.n];
         sums::fill(&mut row, |i| (sign * t * c[i]).exp());
-        let bad = row.iter().any(|z| !z.is_finite());
+        let (bad, max) = row.iter().fold((false, 0.0), |(bad, max), &z| {
+            (bad || !z.is_finite(), if z > max { z } else { max })
+        });
+        self.row_max[axis].push(max);
         self.rows[axis].push(row);
         self.t[axis].push(t);
         if bad {

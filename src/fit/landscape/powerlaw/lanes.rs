@@ -52,6 +52,22 @@ pub(super) fn store(s: &mut [f64], b: usize, g: f64x4) {
     }
 }
 
+/// `f(l, i)` for each point i of `r` in order, l = (i - r.start) mod 4 its lane: full groups of
+/// four, then the rest (no padding), for sums kept as four-element arrays that the compiler
+/// runs as vector operations.
+#[inline(always)]
+pub(super) fn each(r: std::ops::Range<usize>, mut f: impl FnMut(usize, usize)) {
+    let quads = r.start + r.len() / LANES * LANES;
+    for b in (r.start..quads).step_by(LANES) {
+        for l in 0..LANES {
+            f(l, b + l);
+        }
+    }
+    for (l, i) in (quads..r.end).enumerate() {
+        f(l, i);
+    }
+}
+
 /// The sum of the lanes, (l0 + l1) + (l2 + l3).
 #[inline(always)]
 pub(super) fn total(v: f64x4) -> f64 {
@@ -83,5 +99,15 @@ mod tests {
         assert_eq!(total(f64x4::new([1e16, 1.0, -1e16, 1.0])), 0.0);
         assert_eq!(((1e16 + 1.0) - 1e16) + 1.0, 1.0);
         assert_eq!(total(f64x4::new([1.0, 2.0, 3.0, 4.0])), 10.0);
+    }
+
+    #[test]
+    fn each_visits_every_point_once_in_order_with_its_lane() {
+        for r in [0..0, 3..5, 10..21, 8..16] {
+            let mut seen = Vec::new();
+            each(r.clone(), |l, i| seen.push((l, i)));
+            let want: Vec<(usize, usize)> = r.clone().map(|i| ((i - r.start) % 4, i)).collect();
+            assert_eq!(seen, want, "{r:?}");
+        }
     }
 }
