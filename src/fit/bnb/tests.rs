@@ -116,6 +116,47 @@ fn certifies_two_wells_and_proposes_both() {
     );
 }
 
+#[test]
+fn starting_blocks_give_each_cell_a_valid_bound_with_fewer_bounds() {
+    // The 10 x 4 starting cells, bounded by 2 x 2 blocks where a block's exact bound reaches
+    // the best node (0.04, at x = 2, y = 0.5): each starting cell is its own unit cell of the
+    // grid, in row-major order, with a bound at most f's exact minimum over it (the block's
+    // bound where the block decided, else its own, which is exact), and fewer bounds were
+    // computed than there are cells (blocks far from the wells decide).
+    let land = TwoWells {
+        x: vec![],
+        y: vec![],
+        loose: false,
+    };
+    let limits = Limits {
+        max_cells: 100_000,
+        max_rows: 10_000,
+    };
+    let b = Bnb::new(land, [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], limits);
+    assert_eq!(b.start_cells.len(), 40);
+    let step = 1u64 << DEPTH;
+    let mut by_block = 0;
+    for (k, c) in b.start_cells.iter().enumerate() {
+        let (i, j) = (k as u64 / 4, k as u64 % 4);
+        assert_eq!(
+            (c.p0, c.p1),
+            ([i * step, j * step], [(i + 1) * step, (j + 1) * step])
+        );
+        let (x0, x1) = (-5.0 + i as f64, -4.0 + i as f64);
+        let (y0, y1) = (-1.0 + 0.5 * j as f64, -0.5 + 0.5 * j as f64);
+        let exact =
+            lowest(g, x0, x1, &[-1.0, 2.0]) + lowest(|y| (y - 0.3f64).powi(2), y0, y1, &[0.3]);
+        assert!(
+            c.bound.lb <= exact + 1e-15,
+            "cell {i} {j}: {} > {exact}",
+            c.bound.lb
+        );
+        by_block += usize::from(c.bound.lb < exact - 1e-12);
+    }
+    assert!(by_block > 0, "no cell took a block's (lower) bound");
+    assert!(b.cells < 40, "{} bounds for 40 cells", b.cells);
+}
+
 /// Every point of a 201 x 81 sample of the box that `may_hold_below` excludes lies at or above
 /// the target; returns how many were excluded and how many points lie below the target (so
 /// that the check is not vacuous).
