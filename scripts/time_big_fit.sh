@@ -18,6 +18,10 @@
 # time on a busy spell of the host (the build before: 5.0-5.2 s, 2.9-3.0 s in that spell);
 # with the profiles' ends side by side and Levenberg-Marquardt's sums on both cores (eighth
 # session) 3.7-4.0 s and 2.15-2.34 s in another slow spell (0.97 of the wall time before).
+# Ninth session, on a faster host (2 Intel Xeon cores): 2.48 s and 1.31 s at its start; with
+# first-order passes where the sample predicts them, the cell pass's sums in four lanes, the
+# power law's nodes in two passes and the starting cells bounded by blocks 2.28-2.29 s and
+# 1.21 s (per model 0.19-0.91 s).
 #
 # Usage: bash scripts/time_big_fit.sh [BINARY]   (default target/release/restitution)
 set -euo pipefail

@@ -204,12 +204,14 @@ fn fig7_rows_distinct(n: usize) -> Vec<u8> {
 
 /// 100 000 rows of fit data: read, validated and fitted (or refused with one line) within the
 /// limit, for every model: rows that repeat 120 points (merged); and 100 000 distinct points
-/// for each model alone (`scripts/time_big_fit.sh`; README, known limitations): the
-/// one-parameter models 0.3-0.4 s of CPU, `min` 0.8-1.1 s, `product` 1.2-1.5 s and `powerlaw`
+/// for each model alone (`scripts/time_big_fit.sh`; README, known limitations): on 2 AMD EPYC
+/// cores the one-parameter models 0.3-0.4 s of CPU, `min` 0.8-1.1 s, `product` 1.2-1.5 s and `powerlaw`
 /// 1.2-1.6 s (user + system; `product` 1.3-1.6 s and `powerlaw` 1.2-1.4 s with one of the two
 /// cores kept busy by another process). `--model all` on distinct points takes the five fits'
 /// CPU together, less the rows they share (3.7-4.0 s on the two cores, 2.0-2.3 s of wall
-/// time): beyond the limit, so not a case here (README, known limitations).
+/// time). On the faster 2 Intel Xeon cores of 2026-11-27: 0.2 s (`vm`, `pm`), 0.6 s (`min`),
+/// 0.9 s (`product`, `powerlaw`), and `--model all` 2.2-2.3 s of CPU, 1.2 s of wall time:
+/// beyond the limit, so not a case here (README, known limitations).
 #[test]
 fn hundred_thousand_rows_fit() {
     let mut cases = Vec::new();

@@ -222,7 +222,7 @@ pub fn starting_rows(range: (f64, f64), n0: u64) -> Vec<f64> {
 impl<L: Landscape> Bnb<L> {
     /// A uniform starting grid of `n0[k]` cells over `range[k]` (an axis with `n0 = 0` is
     /// inactive: one row at its `lo`). Evaluates every starting node, and bounds every starting
-    /// cell (by blocks where they decide, [`Bnb::start_block`]).
+    /// cell (by blocks of cells where a block's bound decides them: see the module doc).
     pub fn new(land: L, range: [(f64, f64); 2], n0: [u64; 2], limits: Limits) -> Self {
         let mut b = Bnb {
             land,

@@ -2,11 +2,13 @@
 //!
 //! The search's cost is (cells) x (points) (see [`super::search`]): every cell bound, grid node
 //! and grid row is a pass over the points. Small data (below [`PARALLEL_MIN_POINTS`]; the
-//! shipped files have 120 points) are summed in point order on the calling thread, so their fits
-//! are the same to the last bit as before these helpers existed. Large data are cut into fixed
-//! chunks of [`CHUNK`] points summed on all cores (rayon), each chunk in point order, and the
-//! chunks' sums are added in chunk order: the result depends on the chunk size, never on the
-//! number of threads or their timing, so a fit is reproducible.
+//! shipped files have 120 points) are summed in one run on the calling thread. Large data are
+//! cut into fixed chunks of [`CHUNK`] points summed on all cores (rayon), and the chunks' sums
+//! are added in chunk order: the result depends on the chunk size, never on the number of
+//! threads or their timing, so a fit is reproducible. A run is summed as its caller's `part`
+//! sums it: in point order, or in four lanes where a pass says so (the power law's passes and
+//! nodes, the separable cell bound's kernel; each lane in point order, the lanes added in
+//! pairs), the same on every machine.
 //! The reordering changes a sum of n positive terms by at most about n u relative (u = 1.1e-16:
 //! 1e-11 for 100 000 points), far below the search's tolerance (1e-7 relative).
 
@@ -23,9 +25,9 @@ pub fn is_large(n: usize) -> bool {
     n >= PARALLEL_MIN_POINTS
 }
 
-/// The K sums over the points 0..n that `part` gives over a range of them (its loop adds the
-/// points in order): one call over every point for small data, one per chunk for large data,
-/// the chunks' sums then added in chunk order (see the module doc).
+/// The K sums over the points 0..n that `part` gives over a range of them: one call over
+/// every point for small data, one per chunk for large data, the chunks' sums then added in
+/// chunk order (see the module doc).
 pub fn sum<const K: usize>(n: usize, part: impl Fn(Range<usize>) -> [f64; K] + Sync) -> [f64; K] {
     if !is_large(n) {
         return part(0..n);
