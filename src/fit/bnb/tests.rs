@@ -157,6 +157,59 @@ fn starting_blocks_give_each_cell_a_valid_bound_with_fewer_bounds() {
     assert!(b.cells < 40, "{} bounds for 40 cells", b.cells);
 }
 
+/// [`TwoWells`] whose model cannot be evaluated at x = `fails_at` (the row is appended, and
+/// reported failed).
+struct FailsAt {
+    wells: TwoWells,
+    fails_at: f64,
+}
+impl Landscape for FailsAt {
+    fn add_row(&mut self, axis: usize, t: f64) -> Result<(), String> {
+        self.wells.add_row(axis, t)?;
+        if axis == 0 && t == self.fails_at {
+            return Err(format!("no model at x = {t}"));
+        }
+        Ok(())
+    }
+    fn node(&self, r: [usize; 2]) -> f64 {
+        self.wells.node(r)
+    }
+    fn bound(&self, lo: [usize; 2], hi: [usize; 2], target: f64) -> Bound {
+        self.wells.bound(lo, hi, target)
+    }
+}
+
+#[test]
+fn a_row_that_failed_inside_a_starting_block_leaves_its_cells_failed() {
+    // x = -4 is the inner row of the block of cells x in [-5, -3] (far from the wells, where a
+    // block's bound decides): the block's bound rests on its corner rows and would pass over
+    // it. The cells on either side of that row stay failed, and the search says the model
+    // could not be evaluated; every other starting cell is as without the failure.
+    let limits = Limits {
+        max_cells: 100_000,
+        max_rows: 10_000,
+    };
+    let land = FailsAt {
+        wells: TwoWells {
+            x: vec![],
+            y: vec![],
+            loose: false,
+        },
+        fails_at: -4.0,
+    };
+    let mut b = Bnb::new(land, [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], limits);
+    for (k, c) in b.start_cells.iter().enumerate() {
+        let i = k / 4;
+        assert_eq!(c.failed, i < 2, "cell {k}: {c:?}");
+    }
+    b.refine(0.0, &|_| 1e-3);
+    let c = b.certificate(0.0);
+    assert!(
+        c.reasons.iter().any(|w| w.contains("no model at x = -4")),
+        "{c:?}"
+    );
+}
+
 /// Every point of a 201 x 81 sample of the box that `may_hold_below` excludes lies at or above
 /// the target; returns how many were excluded and how many points lie below the target (so
 /// that the check is not vacuous).

@@ -211,8 +211,9 @@ pub(super) const LANES: usize = 4;
 /// The terms of points `range` (consecutive) at x, summed in LANES lanes: the range's point j
 /// into lane j mod LANES, each lane in point order, and the lanes then added in pairs,
 /// (l0 + l1) + (l2 + l3). Four independent sums run at the speed of vector additions where one
-/// sum in point order waits on each addition's latency (the pass was a tenth faster; a sum of
-/// n terms in lanes has fewer terms in a row, so the rounding margins stated for n hold).
+/// sum in point order waits on each addition's latency (the pass a tenth faster on 2 Intel
+/// Xeon cores, `cargo bench --bench landscape`; a sum of n terms in lanes has fewer terms in a
+/// row, so the rounding margins stated for n hold).
 #[inline(always)]
 pub(super) fn run<const MIN: bool, const FIRST: bool, const SECOND: bool>(
     cell: &Cell,
