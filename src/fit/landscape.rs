@@ -82,6 +82,19 @@ mod tests {
         FitData::new(m, obs).unwrap()
     }
 
+    /// `base`'s points repeated to `n`, every speed moved by a fixed pattern of up to 0.1%
+    /// (distinct points: large data the fit cannot merge).
+    fn distinct(base: &FitData, n: usize) -> FitData {
+        let obs = (0..n)
+            .map(|k| {
+                let mut o = base.obs[k % base.obs.len()];
+                o.v_n_m_s *= 1.0 + 1e-3 * ((k * 7919 % 2001) as f64 / 1000.0 - 1.0);
+                o
+            })
+            .collect();
+        FitData::new(base.material, obs).unwrap()
+    }
+
     #[test]
     fn the_monotonicity_the_bounds_rest_on_holds() {
         // e_vm non-increasing in kappa over the master curve's range and e_pm non-decreasing in
@@ -186,15 +199,7 @@ mod tests {
         // (chunks, each with a remainder past its groups of four), exponents across the box.
         // 1e-12 relative: the two sides form the same sums in different orders and forms.
         let base = data();
-        let n = crate::fit::sums::PARALLEL_MIN_POINTS + 1003;
-        let obs = (0..n)
-            .map(|k| {
-                let mut o = base.obs[k % base.obs.len()];
-                o.v_n_m_s *= 1.0 + 1e-3 * ((k * 7919 % 2001) as f64 / 1000.0 - 1.0);
-                o
-            })
-            .collect();
-        let large = FitData::new(base.material, obs).unwrap();
+        let large = distinct(&base, crate::fit::sums::PARALLEL_MIN_POINTS + 1003);
         for d in [base, large] {
             let ev = Evaluator::new(&d, ContactEnd::Overlap, VmMethod::Master);
             let obj = Objective::new(&ev, ModelKind::PowerLaw).unwrap();
@@ -227,16 +232,7 @@ mod tests {
         // Above the parallel threshold the sums are chunked and the power law's bound starts
         // from inside its box (powerlaw.rs): the same check on the 40-point pattern repeated
         // with every speed moved (distinct points), a few cells per kind.
-        let base = data();
-        let n = crate::fit::sums::PARALLEL_MIN_POINTS + 1000;
-        let obs = (0..n)
-            .map(|k| {
-                let mut o = base.obs[k % base.obs.len()];
-                o.v_n_m_s *= 1.0 + 1e-3 * ((k * 7919 % 2001) as f64 / 1000.0 - 1.0);
-                o
-            })
-            .collect();
-        let d = FitData::new(base.material, obs).unwrap();
+        let d = distinct(&data(), crate::fit::sums::PARALLEL_MIN_POINTS + 1000);
         assert!(crate::fit::sums::is_large(d.len()), "{} points", d.len());
         let (e, s) = (190f64.ln(), 4e7f64.ln());
         check_bounds_on(

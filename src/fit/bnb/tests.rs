@@ -23,6 +23,22 @@ fn lowest(f: impl Fn(f64) -> f64, a: f64, b: f64, minima: &[f64]) -> f64 {
     }
     v
 }
+impl TwoWells {
+    fn new(loose: bool) -> Self {
+        TwoWells {
+            x: vec![],
+            y: vec![],
+            loose,
+        }
+    }
+}
+
+/// A budget no test here reaches.
+const AMPLE: Limits = Limits {
+    max_cells: 100_000,
+    max_rows: 10_000,
+};
+
 impl Landscape for TwoWells {
     fn add_row(&mut self, axis: usize, t: f64) -> Result<(), String> {
         if axis == 0 {
@@ -56,15 +72,8 @@ impl Landscape for TwoWells {
 
 #[test]
 fn certifies_two_wells_and_proposes_both() {
-    let land = TwoWells {
-        x: vec![],
-        y: vec![],
-        loose: false,
-    };
-    let limits = Limits {
-        max_cells: 100_000,
-        max_rows: 10_000,
-    };
+    let land = TwoWells::new(false);
+    let limits = AMPLE;
     let mut b = Bnb::new(land, [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], limits);
     let tau = |_: f64| 1e-3;
     let starts = b.initial_minima(f64::INFINITY, 1e-3);
@@ -88,21 +97,13 @@ fn certifies_two_wells_and_proposes_both() {
     }
     // Loose (first-order) bounds need splitting: certified with the budget, unresolved and
     // reported as such with a budget of one cell.
-    let land = TwoWells {
-        x: vec![],
-        y: vec![],
-        loose: true,
-    };
+    let land = TwoWells::new(true);
     let mut b = Bnb::new(land, [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], limits);
     b.refine(0.0, &tau);
     let c = b.certificate(0.0);
     assert!(c.lowest >= -1e-3 && c.reasons.is_empty(), "{c:?}");
     assert!(b.cells > 1000, "{}", b.cells);
-    let land = TwoWells {
-        x: vec![],
-        y: vec![],
-        loose: true,
-    };
+    let land = TwoWells::new(true);
     let tight = Limits {
         max_cells: 1,
         max_rows: 10_000,
@@ -123,15 +124,8 @@ fn starting_blocks_give_each_cell_a_valid_bound_with_fewer_bounds() {
     // grid, in row-major order, with a bound at most f's exact minimum over it (the block's
     // bound where the block decided, else its own, which is exact), and fewer bounds were
     // computed than there are cells (blocks far from the wells decide).
-    let land = TwoWells {
-        x: vec![],
-        y: vec![],
-        loose: false,
-    };
-    let limits = Limits {
-        max_cells: 100_000,
-        max_rows: 10_000,
-    };
+    let land = TwoWells::new(false);
+    let limits = AMPLE;
     let b = Bnb::new(land, [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], limits);
     assert_eq!(b.start_cells.len(), 40);
     let step = 1u64 << DEPTH;
@@ -185,16 +179,9 @@ fn a_row_that_failed_inside_a_starting_block_leaves_its_cells_failed() {
     // block's bound decides): the block's bound rests on its corner rows and would pass over
     // it. The cells on either side of that row stay failed, and the search says the model
     // could not be evaluated; every other starting cell is as without the failure.
-    let limits = Limits {
-        max_cells: 100_000,
-        max_rows: 10_000,
-    };
+    let limits = AMPLE;
     let land = FailsAt {
-        wells: TwoWells {
-            x: vec![],
-            y: vec![],
-            loose: false,
-        },
+        wells: TwoWells::new(false),
         fails_at: -4.0,
     };
     let mut b = Bnb::new(land, [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], limits);
@@ -235,15 +222,8 @@ fn points_the_bounds_exclude_are_above_the_target() {
     // node lies above it; then a budget of 200 cells that leaves cells unresolved. In both the
     // target U - tau (U the best node) lies above f somewhere on the sample, and no point below
     // it may be excluded (the proof the valleys' scans rely on; f is exact, the bounds loose).
-    let limits = Limits {
-        max_cells: 100_000,
-        max_rows: 10_000,
-    };
-    let wells = || TwoWells {
-        x: vec![],
-        y: vec![],
-        loose: true,
-    };
+    let limits = AMPLE;
+    let wells = || TwoWells::new(true);
     let tau = 1e-6;
     let mut b = Bnb::new(wells(), [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], limits);
     assert!(b.may_hold_below([-1.0, 0.3], -1.0), "nothing proved yet");

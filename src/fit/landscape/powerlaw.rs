@@ -133,8 +133,10 @@ impl PowerLaw {
         let (za, zb) = (self.row(0, r[0]), self.row(1, r[1]));
         let (a, b) = (self.t[0][r[0]], self.t[1][r[1]]);
         // Least squares in A_c with each row scaled by its largest value and w by its own: no
-        // overflow in the sums (a scaled z is at most 1, to rounding). A row of zeros (every
-        // exponential underflowed) gives NaN sums, hence A at the end of its box, as before.
+        // overflow in the sums (a scaled z is at most 1, to rounding). A row's largest value is
+        // at least 1, to rounding (the logarithms are centred, so some point's exponent is not
+        // negative) and finite (a row that overflows failed when it was made): the scales are
+        // finite and at most 1.
         let (sa, sb) = (1.0 / self.row_max[0][r[0]], 1.0 / self.row_max[1][r[1]]);
         let (y, ws) = (&self.y[..], &self.w_scaled[..]);
         let [num, den] = sums::sum(self.n, |points| {

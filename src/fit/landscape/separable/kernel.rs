@@ -224,6 +224,9 @@ pub(super) fn run<const MIN: bool, const FIRST: bool, const SECOND: bool>(
 ) -> Terms {
     let mut lanes = [[0.0; LANES]; 9];
     let mut block = [[0.0; BLOCK]; 9];
+    // Without the relaxation's terms only the first is not zero: the others are neither stored
+    // nor added (their sums stay zero, as adding zeros would leave them).
+    let columns = if SECOND { 9 } else { 1 };
     let mut start = range.start;
     while start < range.end {
         let end = (start + BLOCK).min(range.end);
@@ -242,7 +245,7 @@ pub(super) fn run<const MIN: bool, const FIRST: bool, const SECOND: bool>(
                 w: w[j],
             };
             let t = terms::<MIN, FIRST, SECOND>(cell, x, p);
-            for (b, tk) in block.iter_mut().zip(t) {
+            for (b, tk) in block.iter_mut().zip(t).take(columns) {
                 b[j] = tk;
             }
         }
@@ -250,7 +253,7 @@ pub(super) fn run<const MIN: bool, const FIRST: bool, const SECOND: bool>(
         // lanes (point j into lane j mod 4), a vector addition per four points, the lanes held
         // in registers over the block.
         let quads = m / LANES * LANES;
-        for (acc, b) in lanes.iter_mut().zip(&block) {
+        for (acc, b) in lanes.iter_mut().zip(&block).take(columns) {
             let mut a = *acc;
             for q in b[..quads].chunks_exact(LANES) {
                 for l in 0..LANES {
