@@ -32,10 +32,10 @@ use super::models::{Evaluator, ModelKind};
 use super::objective::{Objective, check_size};
 use super::polish::{polish_lm, polish_newton};
 use super::profile::{ProfileOutcome, Profiles, Side, profile_intervals};
-use super::result::{FitResult, show};
+use super::result::FitResult;
 use super::search::{SearchOutcome, global_minimum, share_starting_rows};
 use super::sums;
-use crate::error::{Error, Result};
+use crate::error::{Error, Num, Result};
 use crate::models::viscoelastic::{ContactEnd, VmMethod};
 use rayon::prelude::*;
 use summary::{Rows, summarise};
@@ -137,10 +137,11 @@ fn fit_points(
                 ProfileOutcome::Lower(t) if refits < MAX_REFITS => {
                     refits += 1;
                     let mut again = polish_lm(&obj, &t)?;
+                    // Both in full (shortest round-trip): 1e-7 below prints alike in 4 digits.
                     warnings.push(format!(
                         "a profile found chi2 {} below the minimum {}; refitted from it",
-                        show(again.chi2 + obj.chi2_offset),
-                        show(best.chi2 + obj.chi2_offset)
+                        Num(again.chi2 + obj.chi2_offset),
+                        Num(best.chi2 + obj.chi2_offset)
                     ));
                     if !again.converged {
                         // Levenberg-Marquardt creeping along a narrow curved valley (where a
