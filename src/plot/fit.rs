@@ -123,12 +123,23 @@ fn draw_legend(
     Ok(())
 }
 
-/// Tick values for a log axis: 1, 2, 5 per decade over wide ranges; over less than a factor 3
-/// (e on a log axis usually spans 0.7-1.1) evenly spaced round values, 4 to 10 of them.
+/// Tick values for a log axis: 1, 2, 5 per decade over wide ranges (over more than
+/// MANY_DECADES, 1 in every so many decades); over less than a factor 3 (e on a log axis usually
+/// spans 0.7-1.1) evenly spaced round values, 4 to 10 of them. None for a range that is not
+/// finite, positive and increasing ([`crate::plot::log_axis`] gives none such), and none below
+/// 1e-307 (the decades are powers of ten, which underflow beyond).
 fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    const MANY_DECADES: i32 = 24;
+    if !(lo > 0.0 && lo < hi && hi.is_finite()) {
+        return Vec::new();
+    }
     if hi / lo < 3.0 {
         let raw = (hi - lo) / 6.0;
         let p = 10f64.powi(raw.log10().floor() as i32);
+        // A range of a few subnormals: its ends.
+        if !(p > 0.0 && p.is_finite()) {
+            return vec![lo, hi];
+        }
         let step = [1.0, 2.0, 5.0, 10.0]
             .iter()
             .map(|m| m * p)
@@ -143,16 +154,29 @@ fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
     } else {
         &[1.0, 2.0, 5.0]
     };
+    // Decade by decade from the one below lo (but not below 1e-307: a decade that underflows to 0
+    // would never grow), so at most about 615 of them; over many, 1 in every `every` of them.
+    let first = (lo.log10().floor() as i32).max(-307);
+    let decades = hi.log10().ceil() as i32 - first;
+    let (mantissas, every) = if decades > MANY_DECADES {
+        (&[1.0][..], decades / MANY_DECADES + 1)
+    } else {
+        (mantissas, 1)
+    };
     let mut out = Vec::new();
-    let mut decade = 10f64.powi(lo.log10().floor() as i32);
+    let mut decade = 10f64.powi(first);
+    let mut k = 0;
     while decade <= hi {
-        for &m in mantissas {
-            let t = m * decade;
-            if t >= lo && t <= hi {
-                out.push(t);
+        if k % every == 0 {
+            for &m in mantissas {
+                let t = m * decade;
+                if t >= lo && t <= hi {
+                    out.push(t);
+                }
             }
         }
         decade *= 10.0;
+        k += 1;
     }
     out
 }
@@ -204,5 +228,37 @@ mod tests {
         assert!(t.len() >= 4 && t.len() <= 10, "{t:?}");
         assert!(t.iter().all(|&x| (0.88..=1.03).contains(&x)));
         assert_eq!(short_value(t[2]), "0.92");
+    }
+
+    #[test]
+    fn ticks_end_and_stay_inside_at_the_extremes_of_f64() {
+        // An infinite end made the decade loop run forever (fit --out with v_n = f64::MAX: the
+        // axis's margin overflowed); a decade that underflows to 0 never grows.
+        for (lo, hi) in [
+            (1.0, f64::INFINITY),
+            (0.0, 1.0),
+            (f64::NAN, 1.0),
+            (2.0, 1.0),
+            (1.0, 1.0),
+        ] {
+            assert!(log_ticks(lo, hi).is_empty(), "{lo} {hi}");
+        }
+        let max = f64::MAX;
+        for (lo, hi) in [
+            (max / 1.25, max),
+            (5e-324, 1e-320),
+            (5e-324, 1e-300),
+            (5e-324, max),
+            (1e-320, 1.0),
+            (5e-324, 1e-323),
+        ] {
+            let t = log_ticks(lo, hi);
+            assert!(t.len() <= 100, "{lo} {hi}: {} ticks", t.len());
+            assert!(t.iter().all(|&x| lo <= x && x <= hi), "{lo} {hi}: {t:?}");
+        }
+        // Wide ranges keep their decades' 1s, no more than about MANY_DECADES of them.
+        let t = log_ticks(5e-324, max);
+        assert!((20..=40).contains(&t.len()), "{t:?}");
+        assert_eq!(log_ticks(1e-3, 1e5).len(), 8 * 3 + 1);
     }
 }

@@ -1,7 +1,7 @@
 //! The camera study: relative scatter and bias of measured e against the normal impact speed,
 //! one line per camera, solid for free quadratic fits, dashed for fixed-gravity fits.
 
-use super::{PlotError, PlotFailure};
+use super::{PlotError, PlotFailure, log_axis};
 use crate::experiment::StudyPoint;
 use plotters::prelude::*;
 
@@ -38,11 +38,12 @@ fn draw(points: &[StudyPoint], title: &str) -> Result<String, PlotFailure> {
         .filter(ok)
         .map(|p| (100.0 * p.bias).abs())
         .fold(0.5, f64::max);
-    if !(v_min > 0.0 && s_min > 0.0 && s_max >= s_min) {
+    let (Some(v_axis), Some(s_axis)) = (log_axis(v_min, v_max, 1.3), log_axis(s_min, s_max, 1.5))
+    else {
         return Err(PlotFailure::NothingToDraw(
             "no measurable point in the camera study".into(),
         ));
-    }
+    };
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, (1300, 620)).into_drawing_area();
@@ -50,12 +51,12 @@ fn draw(points: &[StudyPoint], title: &str) -> Result<String, PlotFailure> {
         root.fill(&WHITE).map_err(e)?;
         let root = root.titled(title, ("sans-serif", 26)).map_err(e)?;
         let (left, right) = root.split_horizontally(650);
-        let x_range = (v_min / 1.3..v_max * 1.3).log_scale();
+        let x_range = (v_axis.0..v_axis.1).log_scale();
         let mut scatter = ChartBuilder::on(&left)
             .margin(15)
             .x_label_area_size(60)
             .y_label_area_size(80)
-            .build_cartesian_2d(x_range.clone(), (s_min / 1.5..s_max * 1.5).log_scale())
+            .build_cartesian_2d(x_range.clone(), (s_axis.0..s_axis.1).log_scale())
             .map_err(e)?;
         scatter
             .configure_mesh()
@@ -79,7 +80,7 @@ fn draw(points: &[StudyPoint], title: &str) -> Result<String, PlotFailure> {
             .draw()
             .map_err(e)?;
         bias.draw_series(LineSeries::new(
-            [(v_min / 1.3, 0.0), (v_max * 1.3, 0.0)],
+            [(v_axis.0, 0.0), (v_axis.1, 0.0)],
             BLACK.mix(0.4),
         ))
         .map_err(e)?;

@@ -24,6 +24,24 @@ pub fn colour(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
 
+/// The extent of a log axis over data from `lo` to `hi` with a margin of the factor `pad` on
+/// each side, in finite positive numbers: where the margin would overflow (data near f64::MAX)
+/// or underflow to 0 (subnormal data) that end stays at the data, and a range that is still one
+/// number (a lone subnormal) is widened by 2 each side where it can be. Axes built from user
+/// data go through it: an infinite end made the tick loops run forever. None unless
+/// 0 < lo <= hi < inf.
+pub fn log_axis(lo: f64, hi: f64, pad: f64) -> Option<(f64, f64)> {
+    if !(lo > 0.0 && lo <= hi && hi.is_finite() && pad >= 1.0) {
+        return None;
+    }
+    let kept = |x: f64, data: f64| if x > 0.0 && x.is_finite() { x } else { data };
+    let (mut a, mut b) = (kept(lo / pad, lo), kept(hi * pad, hi));
+    if !(a < b) {
+        (a, b) = (kept(a / 2.0, a), kept(b * 2.0, b));
+    }
+    (a < b).then_some((a, b))
+}
+
 /// Why a figure could not be drawn: which figure, and the kind of failure as a field.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("drawing {figure}: {kind}")]
@@ -101,6 +119,33 @@ pub mod walton;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn log_axes_are_finite_positive_and_hold_the_data() {
+        // Ordinary data: the margin each side, exactly as the figures always had it.
+        assert_eq!(log_axis(0.5, 40.0, 1.25), Some((0.5 / 1.25, 40.0 * 1.25)));
+        let max = f64::MAX;
+        let tiny = 5e-324;
+        for (lo, hi) in [
+            (1.0, max),
+            (max, max),
+            (tiny, tiny),
+            (tiny, 1.0),
+            (1e-310, 1e-309),
+        ] {
+            let (a, b) = log_axis(lo, hi, 1.25).unwrap();
+            assert!(a > 0.0 && b.is_finite() && a < b, "{lo} {hi}: {a} {b}");
+            assert!(a <= lo && hi <= b, "{lo} {hi}: {a} {b}");
+        }
+        for (lo, hi) in [
+            (0.0, 1.0),
+            (2.0, 1.0),
+            (1.0, f64::INFINITY),
+            (f64::NAN, 1.0),
+        ] {
+            assert_eq!(log_axis(lo, hi, 1.25), None, "{lo} {hi}");
+        }
+    }
 
     #[test]
     fn failures_name_the_figure_and_their_kind() {

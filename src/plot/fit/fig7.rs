@@ -9,7 +9,7 @@ use crate::fit::engine::FitSet;
 use crate::fit::models::{ModelKind, predict_e};
 use crate::fit::result::FitResult;
 use crate::models::viscoelastic::{ContactEnd, VmMethod};
-use crate::plot::{PlotError, PlotFailure};
+use crate::plot::{PlotError, PlotFailure, log_axis};
 use plotters::prelude::*;
 
 /// The model's e along `vs` for a group's pair, dropping points the axes cannot show.
@@ -68,8 +68,11 @@ fn draw_fig7(
         }
         let _ = i;
     }
-    let x_range = (vlo / 1.25, vhi * 1.25);
-    let ehi = ehi.max(1.0) * 1.03;
+    let x_range = log_axis(vlo, vhi, 1.25).ok_or_else(|| {
+        PlotFailure::NothingToDraw("no speed that is a finite positive number".into())
+    })?;
+    // e + e_err may overflow: the axis then ends at the largest number.
+    let ehi = (ehi.max(1.0) * 1.03).min(f64::MAX);
     let elo = (elo / 1.05).clamp(1e-4, 0.99);
     let y_range = (elo, ehi);
     let vs = log_points(x_range.0, x_range.1, 240);

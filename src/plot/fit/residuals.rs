@@ -3,7 +3,7 @@
 use super::{Sample, colour, describe, draw_legend, draw_markers, log_ticks, short_value, svg_err};
 use crate::fit::dataset::FitData;
 use crate::fit::engine::FitSet;
-use crate::plot::{PlotError, PlotFailure};
+use crate::plot::{PlotError, PlotFailure, log_axis};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -21,7 +21,9 @@ fn draw_residuals(data: &FitData, set: &FitSet, title: &str) -> Result<String, P
         vlo = vlo.min(o.v_n_m_s);
         vhi = vhi.max(o.v_n_m_s);
     }
-    let x_range = (vlo / 1.25, vhi * 1.25);
+    let x_range = log_axis(vlo, vhi, 1.25).ok_or_else(|| {
+        PlotFailure::NothingToDraw("no speed that is a finite positive number".into())
+    })?;
     let panel_h = 190u32;
     let mut buf = String::new();
     {
@@ -52,7 +54,10 @@ fn draw_residuals(data: &FitData, set: &FitSet, title: &str) -> Result<String, P
                 .normalized_residuals
                 .iter()
                 .fold(0.0f64, |m, r| m.max(r.abs()));
-            let lim = (rmax * 1.15).max(if data.weighted { 3.0 } else { 1e-3 });
+            // At most 1e300: the axis's span must be a finite number.
+            let lim = (rmax * 1.15)
+                .max(if data.weighted { 3.0 } else { 1e-3 })
+                .min(1e300);
             let mut chart = ChartBuilder::on(area)
                 .caption(
                     format!(
