@@ -13,7 +13,8 @@
 
 use super::{DataError, DataFailure, Table};
 use crate::contact::Material;
-use crate::fit::dataset::{FitData, Observation};
+use crate::error::Num;
+use crate::fit::dataset::{E_ERR_MIN, FitData, Observation};
 use std::path::Path;
 
 /// Where the errors of e came from.
@@ -154,17 +155,28 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
             strict_or(&mut above_one, table.cell_error(row, c_e, msg))?;
         }
         let e_err = match (c_eerr, c_verr) {
-            (Some(c), _) => Some(table.number_where(row, c, |x| x > 0.0, "an error > 0")?),
+            (Some(c), _) => Some(table.number_where(
+                row,
+                c,
+                |x| x >= E_ERR_MIN,
+                "an error of at least 5e-11 (1000 times the accuracy e is computed to)",
+            )?),
             (None, Some(c)) => {
                 let dv = table.number_where(row, c, |x| x > 0.0, "a speed error > 0 (m/s)")?;
                 let s = 2.0 * e * dv / v;
-                if !(s > 0.0 && s.is_finite()) {
+                if !(s >= E_ERR_MIN && s.is_finite()) {
                     return Err(table.cell_error(
                         row,
                         c_e,
                         format!(
-                            "'{}' gives sigma_e = 2 e v_err / v_n = {s}: give an e_err column",
-                            table.shown(row, c_e)
+                            "'{}' gives sigma_e = 2 e v_err / v_n = {}{}: give an e_err column",
+                            table.shown(row, c_e),
+                            Num(s),
+                            if s.is_finite() && s > 0.0 {
+                                ", below 5e-11 (1000 times the accuracy e is computed to)"
+                            } else {
+                                ""
+                            }
                         ),
                     ));
                 }
@@ -226,6 +238,28 @@ mod tests {
         let err = parse_fit_csv("f.csv", text, nylon(), true).unwrap_err();
         assert_eq!(err.line, Some(5));
         assert!(err.to_string().contains("--strict"), "{err}");
+    }
+
+    #[test]
+    fn errors_below_what_e_is_computed_to_name_their_cell() {
+        // Given, and derived from v_err for an e of 1e-20: each below 5e-11.
+        let text = "d_mm,v_n_m_s,e,e_err\n12.7,1.0,0.9,0.01\n12.7,2.0,0.8,1e-12\n";
+        let err = parse_fit_csv("f.csv", text, nylon(), false).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "f.csv:3: column 'e_err': '1e-12' is out of range: expected an error of at least \
+             5e-11 (1000 times the accuracy e is computed to)"
+        );
+        let text = "d_mm,v_n_m_s,e,v_err_m_s\n12.7,1.0,0.9,0.04\n12.7,1.0,1e-20,0.5\n";
+        let err = parse_fit_csv("f.csv", text, nylon(), false).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "f.csv:3: column 'e': '1e-20' gives sigma_e = 2 e v_err / v_n = 1e-20, below 5e-11 \
+             (1000 times the accuracy e is computed to): give an e_err column"
+        );
+        // At the floor: accepted.
+        let text = "d_mm,v_n_m_s,e,e_err\n12.7,1.0,0.9,0.01\n12.7,2.0,0.8,5e-11\n";
+        assert!(parse_fit_csv("f.csv", text, nylon(), false).is_ok());
     }
 
     #[test]

@@ -4,6 +4,7 @@
 //! Pure data: no file reading here (that is the I/O layer's `data::fit_input`), so that the kinematics pipeline and
 //! the benchmarks can build a [`FitData`] from numbers they already hold.
 
+use super::objective::{ERROR_PER_ACCURACY, MASTER_ACCURACY};
 use crate::contact::{Contact, Material, Pair, Sphere};
 use crate::error::{Error, Result};
 
@@ -79,9 +80,14 @@ pub fn pair_contact(material: Material, d_mm: f64, d2_mm: Option<f64>) -> Result
     pair.try_contact()
 }
 
+/// The smallest error of e a row may have: [`super::objective::ERROR_PER_ACCURACY`] times the
+/// accuracy of e computed with the master curve, 5e-11 (see there why).
+pub const E_ERR_MIN: f64 = ERROR_PER_ACCURACY * MASTER_ACCURACY;
+
 impl FitData {
-    /// Validates the observations (d > 0, v_n > 0, e >= 0 finite, e_err > 0 finite, either every
-    /// row has an error or none has) and derives each pair's contact.
+    /// Validates the observations (d > 0, v_n > 0, e >= 0 finite, e_err finite and at least
+    /// [`E_ERR_MIN`], either every row has an error or none has) and derives each pair's
+    /// contact.
     pub fn new(material: Material, obs: Vec<Observation>) -> Result<FitData> {
         if obs.is_empty() {
             return Err(bad("number of observations", 0.0, "at least one"));
@@ -103,9 +109,14 @@ impl FitData {
                 return Err(bad("e", o.e, "a finite number >= 0"));
             }
             if let Some(s) = o.e_err
-                && !(s.is_finite() && s > 0.0)
+                && !(s.is_finite() && s >= E_ERR_MIN)
             {
-                return Err(bad("e_err", s, "a finite number > 0"));
+                return Err(bad(
+                    "e_err",
+                    s,
+                    "a finite number of at least 5e-11 (1000 times the accuracy e is computed \
+                     to: below it the residual would be rounding)",
+                ));
             }
             if let Some(d2) = o.d2_mm
                 && not_positive(d2)

@@ -29,8 +29,11 @@
 //! minima within 1e-5 relative of the best are finished: Brent on the profiles where
 //! Levenberg-Marquardt stopped on a kink of `min`, damped Newton where it ran out of iterations,
 //! line searches along the covariance's axes (whose scans skip the points where the bounds
-//! already exclude chi2 below U - tau: [`super::bnb::Bnb::may_hold_below`]). The reported minimum is the lowest point found. A
-//! point below the certified bound would contradict the bounds: a warning, never ignored.
+//! already exclude chi2 below U - tau: [`super::bnb::Bnb::may_hold_below`]). The reported
+//! minimum is the lowest polished point, the best grid node only where every polish ended
+//! above it by more than the rounding of the sums (a node and a polish sum chi2 in different
+//! orders). A point below the certified bound would contradict the bounds: a warning, never
+//! ignored.
 //!
 //! **Costs**: e_vm and e_pm are tabulated once per grid value of eta or sigma_y (a row over all
 //! points, counted as one evaluation); a node of `min` or `product` then costs one min or product
