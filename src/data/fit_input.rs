@@ -257,7 +257,8 @@ mod tests {
             "f.csv:3: column 'e': '1e-20' gives sigma_e = 2 e v_err / v_n = 1e-20, below 5e-11 \
              (1000 times the accuracy e is computed to): give an e_err column"
         );
-        // At the floor: accepted.
+        // At the floor (the messages quote it): accepted.
+        assert_eq!(E_ERR_MIN, 5e-11);
         let text = "d_mm,v_n_m_s,e,e_err\n12.7,1.0,0.9,0.01\n12.7,2.0,0.8,5e-11\n";
         assert!(parse_fit_csv("f.csv", text, nylon(), false).is_ok());
     }
