@@ -244,7 +244,7 @@ fn hundred_thousand_rows_fit() {
 }
 
 /// `--exact` integrates the ODE at every distinct point for every parameter value tried: where
-/// that would take more than about a second (100 000 distinct points: hours) it is refused with
+/// that would take more than about a second (100 000 distinct points: minutes) it is refused with
 /// one line, and where it is allowed it ends within the limit. The fuzzer's own `fit` cases
 /// draw it only for a few rows (README, fuzzing).
 #[test]
