@@ -58,6 +58,13 @@ fn file_case(label: &str, args: &[&str], name: &str, bytes: Vec<u8>, out_dir: bo
     }
 }
 
+/// `fit data.csv --material nylon --model MODEL` and `extra` flags, on `bytes`.
+fn fit_case(label: &str, model: &str, extra: &[&str], bytes: Vec<u8>) -> Case {
+    let mut args = vec!["fit", "data.csv", "--material", "nylon", "--model", model];
+    args.extend_from_slice(extra);
+    file_case(label, &args, "data.csv", bytes, false)
+}
+
 /// Cases 0..n of seed 1 for one subcommand (see `fuzz::cases::case_of`), without the 100 000-row
 /// files (they have their own test); one test per subcommand, so that a failure points at it.
 fn seeded(command: Command_, n: u64, min_ok: usize) {
@@ -177,12 +184,11 @@ fn extreme_error_bars() {
     let mut cases = Vec::new();
     for (rows, e_err) in [(4, "1e-80"), (4, "1e80"), (120, "1e-80"), (4, "5e-324")] {
         for m in models {
-            cases.push(file_case(
+            cases.push(fit_case(
                 &format!("fit --model {m}, {rows} rows, e_err {e_err}"),
-                &["fit", "data.csv", "--material", "nylon", "--model", m],
-                "data.csv",
+                m,
+                &[],
                 fig7_rows(rows, Some(("e_err", e_err))),
-                false,
             ));
         }
     }
@@ -222,22 +228,20 @@ fn fig7_rows_distinct(n: usize) -> Vec<u8> {
 fn hundred_thousand_rows_fit() {
     let mut cases = Vec::new();
     for m in ["vm", "pm", "powerlaw", "min", "product", "all"] {
-        cases.push(file_case(
+        cases.push(fit_case(
             &format!("fit --model {m}, 100 000 rows"),
-            &["fit", "data.csv", "--material", "nylon", "--model", m],
-            "data.csv",
+            m,
+            &[],
             fig7_rows(100_000, None),
-            false,
         ));
     }
     let distinct = fig7_rows_distinct(100_000);
     for m in ["vm", "pm", "min", "product", "powerlaw"] {
-        cases.push(file_case(
+        cases.push(fit_case(
             &format!("fit --model {m}, 100 000 distinct rows"),
-            &["fit", "data.csv", "--material", "nylon", "--model", m],
-            "data.csv",
+            m,
+            &[],
             distinct.clone(),
-            false,
         ));
     }
     assert_clean(&run_all("bigfit", &cases));
@@ -253,20 +257,11 @@ fn exact_ends_within_the_limit_or_is_refused() {
     let repeated = fig7_rows(100_000, None);
     let distinct = fig7_rows_distinct(100_000);
     let case = |label: &str, model: &str, bytes: &Vec<u8>| {
-        file_case(
+        fit_case(
             &format!("fit --exact --model {model}, {label}"),
-            &[
-                "fit",
-                "data.csv",
-                "--material",
-                "nylon",
-                "--model",
-                model,
-                "--exact",
-            ],
-            "data.csv",
+            model,
+            &["--exact"],
             bytes.clone(),
-            false,
         )
     };
     // Allowed: vm and min on the shipped 119 distinct points (0.22 and 0.62 s of CPU on 2
@@ -566,21 +561,11 @@ fn one_cell_case(col: &str, row: usize, value: &str, model: &str) -> Case {
     s.rows.truncate(12);
     let c = s.col(col).unwrap();
     s.rows[row][c] = value.into();
-    file_case(
+    fit_case(
         &format!("fit --model {model}, {col}[{row}] = {value}"),
-        &[
-            "fit",
-            "data.csv",
-            "--material",
-            "nylon",
-            "--model",
-            model,
-            "--format",
-            "csv",
-        ],
-        "data.csv",
+        model,
+        &["--format", "csv"],
         s.to_bytes(),
-        false,
     )
 }
 
