@@ -2,10 +2,13 @@
 //! same cases in `tests/fuzz_cli.rs`).
 //!
 //! Run: `cargo run --release --example fuzz_cli -- --cases N [--seed S] [--from I]
-//! [--no-big] [--command fit|walton|kinematics|predict|simulate|bench] [--verbose]`. It builds the binary first (`cargo build --release --bin
+//! [--no-big] [--command fit|walton|kinematics|predict|simulate|bench] [--verbose]
+//! [--dump DIR]`. It builds the binary first (`cargo build --release --bin
 //! restitution`), runs cases I .. I+N of seed S (default 1), prints every failure (command,
 //! files, what happened) and a summary, and exits 1 if any case failed. `--no-big` leaves out
-//! the 100 000-row files.
+//! the 100 000-row files. `--dump DIR` also writes each case's input files and its arguments
+//! (`DIR/case-I/args.txt`, one per line, `{dir}` standing for the case's directory), to rerun
+//! one by hand.
 
 #[path = "../tests/fuzz/mod.rs"]
 mod fuzz;
@@ -19,6 +22,7 @@ fn main() {
     let mut from = 0u64;
     let mut big = true;
     let mut verbose = false;
+    let mut dump: Option<std::path::PathBuf> = None;
     let mut only: Option<Command> = None;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
@@ -33,6 +37,13 @@ fn main() {
             "--from" => from = num("--from"),
             "--no-big" => big = false,
             "--verbose" => verbose = true,
+            "--dump" => {
+                dump = Some(
+                    args.next()
+                        .unwrap_or_else(|| fail("--dump needs a directory"))
+                        .into(),
+                )
+            }
             "--command" => {
                 only = Some(match args.next().as_deref() {
                     Some("fit") => Command::Fit,
@@ -75,6 +86,9 @@ fn main() {
             Some(command) => case_of(command, seed, i, &base, big),
             None => case(seed, i, &base, big),
         };
+        if let Some(d) = &dump {
+            write_case(&d.join(format!("case-{i}")), &c);
+        }
         let r = runner.check(&c, 0);
         if verbose {
             match &r {
@@ -105,6 +119,18 @@ fn main() {
     let _ = std::fs::remove_dir_all(&runner.root);
     if !tally.failures.is_empty() {
         std::process::exit(1);
+    }
+}
+
+fn write_case(dir: &std::path::Path, c: &fuzz::Case) {
+    let written = std::fs::create_dir_all(dir).and_then(|_| {
+        for (name, bytes) in &c.files {
+            std::fs::write(dir.join(name), bytes)?;
+        }
+        std::fs::write(dir.join("args.txt"), c.args.join("\n") + "\n")
+    });
+    if let Err(e) = written {
+        fail(&format!("--dump: {}: {e}", dir.display()));
     }
 }
 
