@@ -387,11 +387,27 @@ fn bad_input_is_one_line_naming_the_place() {
             "powerlaw",
         ],
         vec!["simulate", "--out", s(&out)],
+        // V_Y = 1e-345 m/s underflows: an error naming sigma_y (it made e = 0 for every
+        // collision, silently).
+        vec![
+            "simulate",
+            "--material",
+            "nylon",
+            "--out",
+            s(&out),
+            "--model",
+            "pm",
+            "--sigma-y-pa",
+            "1e-130",
+        ],
     ] {
         let o = Command::new(bin()).args(&args).output().unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success(), "{args:?}");
         assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        if args.contains(&"1e-130") {
+            assert!(err.contains("sigma_y = 1e-130 Pa"), "{err}");
+        }
         assert!(!out.exists(), "{args:?} wrote output");
     }
 }

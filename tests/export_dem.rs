@@ -243,8 +243,8 @@ fn min_kink_is_where_the_branches_cross() {
     // The yield speed (Eq. 15: 6.3233 m/s) and the crossing e_vm = e_pm.
     assert!((kinks[0] - 6.3233).abs() < 5e-5, "{kinks:?}");
     let v = kinks[1];
-    let gap =
-        e_vm(&c, v, 190.0, ContactEnd::Overlap, &VmMethod::Master).unwrap() - e_pm(&c, v, 4e7);
+    let gap = e_vm(&c, v, 190.0, ContactEnd::Overlap, &VmMethod::Master).unwrap()
+        - e_pm(&c, v, 4e7).unwrap();
     assert!(gap.abs() < 1e-12 && v > 6.3233, "{v} {gap}");
 }
 

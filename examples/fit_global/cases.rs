@@ -17,6 +17,8 @@ pub enum Truth {
     Additive,
     /// 1 - e = c1 (v/1 m/s)^p + c2 (v/1 m/s)^q.
     TwoPowers,
+    /// Not made here: a data file given (`--dumped`), truth unknown.
+    File,
 }
 
 impl Truth {
@@ -25,6 +27,7 @@ impl Truth {
             Truth::Model(k) => k.name().to_string(),
             Truth::Additive => "additive".into(),
             Truth::TwoPowers => "two_powers".into(),
+            Truth::File => "file".into(),
         }
     }
 }
@@ -119,9 +122,10 @@ pub fn make_case(seed: u64) -> Case {
                 }
                 Truth::Additive => {
                     let a = e_vm(&c, v, eta, rule, &m).expect("model");
-                    let b = e_pm(&c, v, sigma_y);
+                    let b = e_pm(&c, v, sigma_y).expect("model");
                     (a * a + b * b - 1.0).max(0.0).sqrt()
                 }
+                Truth::File => unreachable!("drawn truths only"),
                 Truth::TwoPowers => {
                     let x = v / POWERLAW_V_REF_M_S;
                     (1.0 - two[0] * x.powf(two[1]) - two[2] * x.powf(two[3])).max(0.02)

@@ -4,7 +4,14 @@
 //! ```text
 //! cargo run --release --example fit_global            # the full run (400 data sets)
 //! cargo run --release --example fit_global -- 0 40    # seeds 0..40 only
+//! cargo run --release --example fit_global -- --dumped DIR
 //! ```
+//!
+//! `--dumped DIR` checks data files instead: the `fit` cases the fuzzer wrote with `--dump DIR`
+//! (`DIR/case-I/args.txt` and the file it names), each read as the command line would read it
+//! (its material flags and `--strict`); files it refuses, and cases with `--exact` or the force
+//! rule, are skipped. The fuzzer's inputs are far from the synthetic sets: a few rows, speeds of
+//! 1e-300 or 1e300 m/s, duplicated rows, extreme error bars.
 //!
 //! **Data sets** (seed s, rand's StdRng): a material (nu uniform in 0.2-0.49, rho log-uniform in
 //! 900-8000 kg/m^3, Y log-uniform in 1e8-2e11 Pa), one to four diameters (1-50 mm) as identical
@@ -33,8 +40,14 @@ use cases::Case;
 use reference::Outcome;
 
 fn main() {
-    let args: Vec<u64> = std::env::args()
-        .skip(1)
+    let raw: Vec<String> = std::env::args().skip(1).collect();
+    if let [flag, dir] = raw.as_slice()
+        && flag == "--dumped"
+    {
+        return dumped(std::path::Path::new(dir));
+    }
+    let args: Vec<u64> = raw
+        .iter()
         .map(|a| a.parse().expect("seed numbers"))
         .collect();
     let (from, to) = match args.as_slice() {
@@ -42,34 +55,111 @@ fn main() {
         _ => (0, 400),
     };
     let seeds: Vec<u64> = (from..to).collect();
+    let results = in_threads(seeds, |seed| {
+        let case = cases::make_case(seed);
+        let out = reference::check(&case);
+        (case, out)
+    });
+    report(&results, &format!("seeds {from}..{to}"));
+}
+
+/// The `fit` cases of a fuzzer's dump (see the module doc): each case's number stands for the
+/// seed in the report.
+fn dumped(dir: &std::path::Path) {
+    let mut found: Vec<(u64, std::path::PathBuf)> = std::fs::read_dir(dir)
+        .expect("the dump directory")
+        .filter_map(|e| {
+            let p = e.ok()?.path();
+            let i = p
+                .file_name()?
+                .to_str()?
+                .strip_prefix("case-")?
+                .parse()
+                .ok()?;
+            Some((i, p))
+        })
+        .collect();
+    found.sort();
+    let cases: Vec<Case> = found.iter().filter_map(|(i, p)| read_case(*i, p)).collect();
+    println!(
+        "{} of {} cases are fits of data the command line reads",
+        cases.len(),
+        found.len()
+    );
+    let results = in_threads(cases, |case| {
+        let out = reference::check_data(case.seed, case.truth, &case.data);
+        (case, out)
+    });
+    report(
+        &results,
+        &format!("{} fuzz cases of {}", results.len(), dir.display()),
+    );
+}
+
+fn read_case(i: u64, dir: &std::path::Path) -> Option<Case> {
+    let text = std::fs::read_to_string(dir.join("args.txt")).ok()?;
+    let args: Vec<&str> = text.lines().collect();
+    if args.first() != Some(&"fit") || args.contains(&"--exact") {
+        return None;
+    }
+    let value = |flag: &str| {
+        args.iter()
+            .position(|a| *a == flag)
+            .and_then(|k| args.get(k + 1).copied())
+    };
+    if value("--contact-end").is_some_and(|r| r != "overlap") {
+        return None;
+    }
+    let material = match value("--material") {
+        Some(name) => restitution::contact::Material::preset(name)?,
+        None => restitution::contact::Material::new(
+            value("--youngs-pa")?.parse().ok()?,
+            value("--poisson")?.parse().ok()?,
+            value("--density-kg-m3")?.parse().ok()?,
+        )
+        .ok()?,
+    };
+    let file = dir.join(args.get(1)?.replace("{dir}/", ""));
+    let input =
+        restitution::data::fit_input::read_fit_csv(&file, material, args.contains(&"--strict"))
+            .ok()?;
+    Some(Case {
+        seed: i,
+        truth: cases::Truth::File,
+        data: input.data,
+        description: format!("{}", dir.display()),
+    })
+}
+
+/// `work` on every item, on two threads (items dealt alternately), results in the threads'
+/// order.
+fn in_threads<T: Send, R: Send>(items: Vec<T>, work: impl Fn(T) -> R + Sync) -> Vec<R> {
     let threads = 2;
-    let results: Vec<(Case, Vec<Outcome>)> = std::thread::scope(|s| {
-        let handles: Vec<_> = (0..threads)
-            .map(|t| {
-                let mine: Vec<u64> = seeds.iter().copied().skip(t).step_by(threads).collect();
-                s.spawn(move || {
-                    mine.into_iter()
-                        .map(|seed| {
-                            let case = cases::make_case(seed);
-                            let out = reference::check(&case);
-                            (case, out)
-                        })
-                        .collect::<Vec<_>>()
-                })
-            })
+    let mut shares: Vec<Vec<T>> = (0..threads).map(|_| Vec::new()).collect();
+    for (k, item) in items.into_iter().enumerate() {
+        shares[k % threads].push(item);
+    }
+    let work = &work;
+    std::thread::scope(|s| {
+        let handles: Vec<_> = shares
+            .into_iter()
+            .map(|mine| s.spawn(move || mine.into_iter().map(work).collect::<Vec<R>>()))
             .collect();
         handles
             .into_iter()
             .flat_map(|h| h.join().expect("worker"))
             .collect()
-    });
+    })
+}
+
+fn report(results: &[(Case, Vec<Outcome>)], what: &str) {
     let mut total = 0;
     let mut failed = 0;
     let mut uncertified = 0;
     let mut unconverged = 0;
     let mut per_model = std::collections::BTreeMap::new();
     let mut per_truth = std::collections::BTreeMap::new();
-    for (case, outs) in &results {
+    for (case, outs) in results {
         *per_truth.entry(case.truth.name()).or_insert(0) += 1;
         for o in outs {
             total += 1;
@@ -100,7 +190,7 @@ fn main() {
         }
     }
     println!(
-        "fit_global: {} data sets (seeds {from}..{to}), {total} fits: {failed} above the \
+        "fit_global: {} data sets ({what}), {total} fits: {failed} above the \
          reference by more than 1e-6 relative; {uncertified} not certified global, \
          {unconverged} not converged",
         results.len()

@@ -197,7 +197,7 @@ pub fn reference(data: &FitData, kind: ModelKind) -> (f64, Vec<f64>) {
         data.obs
             .iter()
             .zip(&data.contacts)
-            .map(|(o, c)| e_pm(c, o.v_n_m_s, t.exp()))
+            .map(|(o, c)| e_pm(c, o.v_n_m_s, t.exp()).unwrap_or(f64::NAN))
             .collect()
     };
     let chi2_of = |e: &dyn Fn(usize) -> f64| -> f64 {
@@ -319,16 +319,21 @@ impl Outcome {
 
 /// Fits every model to the case and compares with the reference.
 pub fn check(case: &Case) -> Vec<Outcome> {
+    check_data(case.seed, case.truth, &case.data)
+}
+
+/// As [`check`], for any data (their e_vm by the overlap rule).
+pub fn check_data(seed: u64, truth: Truth, data: &FitData) -> Vec<Outcome> {
     ModelKind::ALL
         .iter()
-        .filter(|k| case.data.len() > k.n_params())
+        .filter(|k| data.len() > k.n_params())
         .map(|&kind| {
-            let r = fit(&case.data, kind, &FitOptions::default());
-            let ref_chi2 = reference_chi2(&case.data, kind);
+            let r = fit(data, kind, &FitOptions::default());
+            let ref_chi2 = reference_chi2(data, kind);
             match r {
                 Ok(f) => Outcome {
-                    seed: case.seed,
-                    truth: case.truth,
+                    seed,
+                    truth,
                     kind,
                     fit_chi2: f.chi2,
                     ref_chi2,
@@ -337,8 +342,8 @@ pub fn check(case: &Case) -> Vec<Outcome> {
                     error: None,
                 },
                 Err(e) => Outcome {
-                    seed: case.seed,
-                    truth: case.truth,
+                    seed,
+                    truth,
                     kind,
                     fit_chi2: f64::NAN,
                     ref_chi2,

@@ -88,13 +88,13 @@ impl FittedCurve {
     pub fn kinks(&self, contact: &Contact, range: &SpeedRange) -> Result<Vec<f64>> {
         let mut out = Vec::new();
         if let Some(sy) = self.sigma_y() {
-            out.push(contact.yield_velocity_m_s(sy));
+            out.push(contact.try_yield_velocity_m_s(sy)?);
         }
         if self.kind == ModelKind::Min {
             let (eta, sy) = (self.params[0], self.params[1]);
             let diff = |v: f64| -> Result<f64> {
                 Ok(e_vm(contact, v, eta, self.rule, &VmMethod::Master)?
-                    - crate::fit::models::e_pm(contact, v, sy))
+                    - crate::fit::models::e_pm(contact, v, sy)?)
             };
             let grid = range.log_grid(400);
             let mut prev = (grid[0], diff(grid[0])?);

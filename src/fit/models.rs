@@ -21,7 +21,7 @@ use super::dataset::FitData;
 use super::sums;
 use super::vexp;
 use crate::contact::Contact;
-use crate::error::{Error, Result};
+use crate::error::{Error, Num, Result};
 use crate::models::plastic;
 use crate::models::viscoelastic::{self, ContactEnd, VmMethod, master};
 use std::collections::HashMap;
@@ -167,8 +167,22 @@ pub fn e_vm(
 }
 
 /// e_pm of one contact at one speed for yield stress sigma_y (docs/physics.md §3 closed form).
-pub fn e_pm(contact: &Contact, v_m_s: f64, sigma_y_pa: f64) -> f64 {
-    plastic::e_of_u(v_m_s / contact.yield_velocity_m_s(sigma_y_pa))
+/// V_Y is the checked one ([`Contact::try_yield_velocity_m_s`]): an error naming sigma_y and the
+/// contact where it is not a normal f64, and one naming v and V_Y where u = v/V_Y overflows.
+/// (The direct formula underflows in its intermediates first: V_Y = 0 from sigma_y = 1e-79 Pa
+/// on a 0.2 mm sphere, where V_Y is 3.8e-206 m/s, made e = 0; and near that edge it was off in
+/// the sixth digit.)
+pub fn e_pm(contact: &Contact, v_m_s: f64, sigma_y_pa: f64) -> Result<f64> {
+    let vy = contact.try_yield_velocity_m_s(sigma_y_pa)?;
+    let u = v_m_s / vy;
+    if !u.is_finite() {
+        return Err(Error::OutOfRange {
+            quantity: "u = V/V_Y",
+            value: u,
+            cause: format!("v = {} m/s, V_Y = {} m/s", Num(v_m_s), Num(vy)),
+        });
+    }
+    Ok(plastic::e_of_u(u))
 }
 
 /// The size variable of the power law, 4 R~ in mm (the diameter for identical spheres).
@@ -200,12 +214,12 @@ pub fn predict_e(
     }
     Ok(match kind {
         ModelKind::Vm => e_vm(contact, v_m_s, physical[0], rule, method)?,
-        ModelKind::Pm => e_pm(contact, v_m_s, physical[0]),
+        ModelKind::Pm => e_pm(contact, v_m_s, physical[0])?,
         ModelKind::Min => {
-            e_vm(contact, v_m_s, physical[0], rule, method)?.min(e_pm(contact, v_m_s, physical[1]))
+            e_vm(contact, v_m_s, physical[0], rule, method)?.min(e_pm(contact, v_m_s, physical[1])?)
         }
         ModelKind::Product => {
-            e_vm(contact, v_m_s, physical[0], rule, method)? * e_pm(contact, v_m_s, physical[1])
+            e_vm(contact, v_m_s, physical[0], rule, method)? * e_pm(contact, v_m_s, physical[1])?
         }
         ModelKind::PowerLaw => e_powerlaw(
             powerlaw_d_mm(contact),
@@ -621,6 +635,58 @@ mod tests {
         // The power law's size is 4 R~: the diameter for identical spheres, 2 d on a wall.
         assert!((powerlaw_d_mm(&data.contacts[0]) - 6.35).abs() < 1e-12);
         assert!((powerlaw_d_mm(&data.contacts[1]) - 25.4).abs() < 1e-12);
+    }
+
+    #[test]
+    fn e_pm_is_right_or_an_error_at_extreme_yield_stresses() {
+        // A 0.2 mm nylon pair at sigma_y = 1e-79 Pa: V_Y is about 3.8e-206 m/s, a normal
+        // double, but the direct formula's intermediates underflowed to V_Y = 0 (e = 0). The
+        // reference V_Y comes from V_Y ~ sigma_y^(5/2) in logarithms, from sigma_y = 4e7 Pa
+        // (a path that never underflows): rounding of exp at |ln| ~ 470 is ~5e-14 relative, and
+        // e ~ u^(-1/4) far beyond yield, so 1e-12 relative is the tolerance.
+        let m = Material::preset("nylon").unwrap();
+        let c = crate::fit::dataset::pair_contact(m, 0.2, None).unwrap();
+        let v_ref = c.yield_velocity_m_s(4e7);
+        for sigma in [1e-79, 1e-60, 1e-40, 1e3, 4e7] {
+            let vy = (v_ref.ln() + 2.5 * (sigma / 4e7f64).ln()).exp();
+            for v in [1e-3, 1.0, 30.0] {
+                let want = plastic::e_of_u(v / vy);
+                let got = e_pm(&c, v, sigma).unwrap();
+                assert!(
+                    (got / want - 1.0).abs() < 1e-12,
+                    "sigma_y {sigma:e} v {v}: {got:e} against {want:e}"
+                );
+                let p = predict_e(
+                    ModelKind::Pm,
+                    &c,
+                    v,
+                    &[sigma],
+                    ContactEnd::Overlap,
+                    &VmMethod::Master,
+                );
+                assert_eq!(p.unwrap(), got);
+            }
+        }
+        // V_Y below the normal range (1e-130 Pa: ~1e-345 m/s), and u = v/V_Y beyond f64::MAX:
+        // errors naming the input, not e = 0.
+        let msg = e_pm(&c, 1.0, 1e-130).unwrap_err().to_string();
+        assert!(
+            msg.contains("V_Y") && msg.contains("sigma_y = 1e-130 Pa"),
+            "{msg}"
+        );
+        let msg = e_pm(&c, 1e300, 1e-110).unwrap_err().to_string();
+        assert!(
+            msg.contains("u = V/V_Y") && msg.contains("v = 1e300 m/s"),
+            "{msg}"
+        );
+        for kind in [ModelKind::Pm, ModelKind::Min, ModelKind::Product] {
+            let p: Vec<f64> = if kind == ModelKind::Pm {
+                vec![1e-130]
+            } else {
+                vec![190.0, 1e-130]
+            };
+            assert!(predict_e(kind, &c, 1.0, &p, ContactEnd::Overlap, &VmMethod::Master).is_err());
+        }
     }
 
     #[test]
