@@ -155,6 +155,9 @@ fn in_threads<T: Send, R: Send>(items: Vec<T>, work: impl Fn(T) -> R + Sync) -> 
 fn report(results: &[(Case, Vec<Outcome>)], what: &str) {
     let mut total = 0;
     let mut failed = 0;
+    let mut refused = 0;
+    let mut within_gap = 0;
+    let mut false_certificates = 0;
     let mut uncertified = 0;
     let mut unconverged = 0;
     let mut per_model = std::collections::BTreeMap::new();
@@ -165,17 +168,32 @@ fn report(results: &[(Case, Vec<Outcome>)], what: &str) {
             total += 1;
             let e = per_model.entry(o.kind.name()).or_insert((0, 0));
             e.0 += 1;
+            if !o.certificate_holds() {
+                false_certificates += 1;
+                println!(
+                    "CERT seed {} fit {}: fit chi2 {:e} reference {:e}, certified gap {:e}, {} fine cells {}",
+                    o.seed, o.kind, o.fit_chi2, o.ref_chi2, o.gap, o.fine_cells, case.description
+                );
+            }
             if !o.pass() {
                 failed += 1;
                 e.1 += 1;
+                refused += o.error.is_some() as usize;
+                let explained = o.error.is_none() && o.certificate_holds() && o.certified;
+                within_gap += explained as usize;
                 println!(
-                    "FAIL seed {} truth {} fit {}: fit chi2 {} reference {} ({}) {}",
+                    "FAIL seed {} truth {} fit {}: fit chi2 {:e} reference {:e} ({}){} {}",
                     o.seed,
                     o.truth.name(),
                     o.kind,
                     o.fit_chi2,
                     o.ref_chi2,
                     o.error.as_deref().unwrap_or("-"),
+                    if explained {
+                        format!(" within the certified gap {:e}", o.gap)
+                    } else {
+                        String::new()
+                    },
                     case.description
                 );
             }
@@ -191,8 +209,9 @@ fn report(results: &[(Case, Vec<Outcome>)], what: &str) {
     }
     println!(
         "fit_global: {} data sets ({what}), {total} fits: {failed} above the \
-         reference by more than 1e-6 relative; {uncertified} not certified global, \
-         {unconverged} not converged",
+         reference by more than 1e-6 relative ({refused} of them refused with an error, \
+         {within_gap} within the gap their certificate states); {false_certificates} false \
+         certificates; {uncertified} not certified global, {unconverged} not converged",
         results.len()
     );
     println!("truths: {per_truth:?}");

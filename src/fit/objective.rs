@@ -9,8 +9,9 @@
 //!   says so) and the master curve hands over to its large-kappa laws;
 //! - log sigma_y from where every point has V/V_Y >= 1e6 (e_pm < 0.04) up to where no point
 //!   yields (V_Y >= 1.5 v for every point: the plateau where sigma_y stops mattering);
-//! - powerlaw: A in [1e-9, 1e3], a and b in [-10, 10], the exponents narrowed (with a warning)
-//!   for data so extreme that A (d/10 mm)^(-a) (v/1 m/s)^b would overflow inside the box.
+//! - powerlaw: A in [1e-9, 1e3], a and b in [-10, 10], each end of the exponents narrowed (with a
+//!   warning) for data so extreme that 1 - e = A (d/10 mm)^(-a) (v/1 m/s)^b would leave
+//!   [1e-304, 1e130] at some point inside the box ([`powerlaw_exponent_ends`]).
 //!
 //! **Chi2 scale** s (one convention for `stderr` and the intervals): weighted fits use
 //! s = max(1, chi2/dof), the Particle Data Group's scale-factor rule (errors as given, unless the
@@ -30,9 +31,13 @@ use std::sync::atomic::{AtomicU64, Ordering};
 /// chi2 quantile of one degree of freedom at 95% (the profile-likelihood interval threshold).
 pub const CHI2_1DOF_95: f64 = 3.841458820694124;
 
-/// Largest |ln(1 - e)| the power law may reach inside its box: exp(300) = 1.9e130, whose square
+/// Largest ln(1 - e) the power law may reach inside its box: exp(300) = 1.9e130, whose square
 /// (the search forms sums of squares of the model) stays below f64::MAX = 1.8e308.
 const POWERLAW_MAX_EXPONENT: f64 = 300.0;
+/// Largest -ln(1 - e) inside the box: exp(-700) = 9.9e-305 is a normal double (from 2.2e-308
+/// down, doubles lose relative precision); its square may underflow in the sums, where it
+/// stands beside terms at least 1e-304 times larger.
+const POWERLAW_MIN_EXPONENT: f64 = 700.0;
 
 /// The least-squares problem of one model on one data set, counting its evaluations.
 pub struct Objective<'a> {
@@ -304,7 +309,7 @@ fn box_error(what: &'static str, value: f64) -> Error {
     Error::InvalidParameter {
         name: what,
         value,
-        expected: "a finite search range (the data's speeds or sizes are too extreme)",
+        expected: "a finite search range (the data's speeds or sizes, or the material's constants, are too extreme)",
     }
 }
 
@@ -355,27 +360,77 @@ fn search_box(
         }
         ModelKind::PowerLaw => {
             let (a_lo, a_hi) = (1e-9f64.ln(), 1e3f64.ln());
-            let mut reach: f64 = 0.0;
-            for (o, c) in ev.data.obs.iter().zip(&ev.data.contacts) {
-                let x1 = (powerlaw_d_mm(c) / POWERLAW_D_REF_MM).ln().abs();
-                let x2 = (o.v_n_m_s / POWERLAW_V_REF_M_S).ln().abs();
-                reach = reach.max(x1 + x2);
+            let x: Vec<[f64; 2]> = ev
+                .data
+                .obs
+                .iter()
+                .zip(&ev.data.contacts)
+                .map(|(o, c)| {
+                    [
+                        (powerlaw_d_mm(c) / POWERLAW_D_REF_MM).ln(),
+                        (o.v_n_m_s / POWERLAW_V_REF_M_S).ln(),
+                    ]
+                })
+                .collect();
+            let ends = powerlaw_exponent_ends(&x, a_hi, a_lo)?;
+            if ends != [-10.0, 10.0, -10.0, 10.0] {
+                warnings.push(format!(
+                    "powerlaw: exponents searched in a in [{:.3}, {:.3}], b in [{:.3}, {:.3}] \
+                     instead of [-10, 10]: beyond, A (d/10 mm)^(-a) (v/1 m/s)^b would leave \
+                     [1e-304, 1e130] at some point of the data",
+                    ends[0], ends[1], ends[2], ends[3]
+                ));
             }
+            (vec![a_lo, ends[0], ends[2]], vec![a_hi, ends[1], ends[3]])
+        }
+    })
+}
+
+/// The power law's exponent box [a_lo, a_hi] x [b_lo, b_hi] (within [-10, 10]^2), given each
+/// point's x = (ln(d/10 mm), ln(v/1 m/s)) and the ends of ln A: every end as far out as keeps
+/// ln(1 - e) = ln A - a x1 + b x2 in [-POWERLAW_MIN_EXPONENT, POWERLAW_MAX_EXPONENT] at every
+/// point of the box, and the same for the search's centred rows (x less its mean over the
+/// points, the amplitude's range aside).
+///
+/// Why each end on its own: the largest of -a x1 + b x2 over the box, for one point, sits at
+/// the end of a that the sign of x1 picks and the end of b that the sign of x2 picks (the
+/// smallest at the other two). If each of those two ends is at most room / (|x1| + |x2|), their
+/// terms add up to at most room. So an end is limited only by the points that load it on the
+/// side that can overflow, and on the other side by those that can underflow: one speed of
+/// 1e-300 m/s limits b from below to about 0.42 (exp(-0.42 x -691) reaches 1e126) but from
+/// above only to about 1 (reaching 1e-300): a box symmetric in |a| and |b| would stop both at
+/// 0.42 and miss the data's b = 0.45.
+fn powerlaw_exponent_ends(x: &[[f64; 2]], ln_a_hi: f64, ln_a_lo: f64) -> Result<[f64; 4]> {
+    let up = POWERLAW_MAX_EXPONENT - ln_a_hi;
+    let down = POWERLAW_MIN_EXPONENT + ln_a_lo;
+    let n = x.len() as f64;
+    let mean = [0, 1].map(|k| x.iter().map(|p| p[k]).sum::<f64>() / n);
+    // [a_lo, a_hi, b_lo, b_hi] as magnitudes; the end each sign of x1 (or x2) loads when the
+    // sum is largest: x1 > 0 loads a_lo, x1 < 0 a_hi; x2 > 0 loads b_hi, x2 < 0 b_lo (the
+    // smallest: the other ones).
+    let mut ends = [10.0f64; 4];
+    for centred in [false, true] {
+        for p in x {
+            let (x1, x2) = if centred {
+                (p[0] - mean[0], p[1] - mean[1])
+            } else {
+                (p[0], p[1])
+            };
+            let reach = x1.abs() + x2.abs();
             if !reach.is_finite() {
                 return Err(box_error("largest |ln(d/10 mm)| + |ln(v/1 m/s)|", reach));
             }
-            let mut e = 10.0;
-            let room = POWERLAW_MAX_EXPONENT - a_hi;
-            if e * reach > room {
-                e = room / reach;
-                warnings.push(format!(
-                    "powerlaw: exponents a and b searched in [-{e:.3}, {e:.3}] instead of \
-                     [-10, 10]: the data's sizes and speeds would make the model overflow"
-                ));
+            if reach == 0.0 {
+                continue;
             }
-            (vec![a_lo, -e, -e], vec![a_hi, e, e])
+            let (a_up, a_down) = if x1 > 0.0 { (0, 1) } else { (1, 0) };
+            let (b_up, b_down) = if x2 > 0.0 { (3, 2) } else { (2, 3) };
+            for (k, room) in [(a_up, up), (b_up, up), (a_down, down), (b_down, down)] {
+                ends[k] = ends[k].min(room / reach);
+            }
         }
-    })
+    }
+    Ok([-ends[0], ends[1], -ends[2], ends[3]])
 }
 
 /// Checks that `data` can be fitted by `kind` at all (more points than parameters).
@@ -397,6 +452,79 @@ mod tests {
     use crate::fit::dataset::Observation;
     use crate::fit::lsq;
     use crate::models::viscoelastic::ContactEnd;
+
+    #[test]
+    fn powerlaw_exponent_ends_keep_every_point_in_range() {
+        let (ln_a_lo, ln_a_hi) = (1e-9f64.ln(), 1e3f64.ln());
+        // Ordinary data: the full [-10, 10] box.
+        let x: Vec<[f64; 2]> = [(6.35, 0.5), (25.4, 40.0), (12.7, 3.0)]
+            .iter()
+            .map(|&(d, v): &(f64, f64)| [(d / 10.0).ln(), v.ln()])
+            .collect();
+        assert_eq!(
+            powerlaw_exponent_ends(&x, ln_a_hi, ln_a_lo).unwrap(),
+            [-10.0, 10.0, -10.0, 10.0]
+        );
+        // One speed of 1e-300 m/s among ordinary ones: b is held from below by that point's
+        // overflow, ln(1e3) - b ln(1e-300) <= 300 (with its |x1| = ln 2.54), and from above by its
+        // underflow, ln(1e-9) + b ln(1e-300) >= -700 (the centred logarithms reach less far:
+        // the mean of x2 is about -172, so the point's centred x2 is about -519, and the
+        // others' about +175 hold b_hi only to about 1.7).
+        let mut x = x;
+        x.push([2.54f64.ln(), 1e-300f64.ln()]);
+        let ends = powerlaw_exponent_ends(&x, ln_a_hi, ln_a_lo).unwrap();
+        let reach = 2.54f64.ln() + 300.0 * 10f64.ln();
+        assert!(
+            (ends[2] + (300.0 - ln_a_hi) / reach).abs() < 1e-15,
+            "{ends:?}"
+        );
+        assert!(
+            (ends[3] - (700.0 + ln_a_lo) / reach).abs() < 1e-15,
+            "{ends:?}"
+        );
+        assert!(ends[3] > 0.95, "b up to about 0.96, not 0.42: {ends:?}");
+        // Random data sets over 600 decades of speed and 20 of size: at every corner of the
+        // box (and so everywhere in it: the exponent is linear in a and b) every point's
+        // ln(1 - e), at both ends of ln A, and its centred exponent stay within the limits
+        // (to rounding: 1e-12 relative).
+        let mut z = 5u64;
+        let mut next = || {
+            z = z
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (z >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut narrowed = 0;
+        for _ in 0..300 {
+            let n = 1 + (next() * 6.0) as usize;
+            let x: Vec<[f64; 2]> = (0..n)
+                .map(|_| {
+                    [
+                        (next() - 0.5) * 46.0,
+                        (next() - 0.5) * 1380.0 * next().powi(3),
+                    ]
+                })
+                .collect();
+            let e = powerlaw_exponent_ends(&x, ln_a_hi, ln_a_lo).unwrap();
+            narrowed += usize::from(e != [-10.0, 10.0, -10.0, 10.0]);
+            let mean = [0, 1].map(|k| x.iter().map(|p| p[k]).sum::<f64>() / n as f64);
+            for p in &x {
+                for (x1, x2) in [(p[0], p[1]), (p[0] - mean[0], p[1] - mean[1])] {
+                    for a in [e[0], e[1]] {
+                        for b in [e[2], e[3]] {
+                            let t = -a * x1 + b * x2;
+                            assert!(
+                                ln_a_hi + t <= 300.0 * (1.0 + 1e-12)
+                                    && ln_a_lo + t >= -700.0 * (1.0 + 1e-12),
+                                "{x:?}: ends {e:?}, a {a} b {b}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+        assert!(narrowed > 100, "most draws narrow the box: {narrowed}");
+    }
 
     /// The power law's closed-form Jacobian against central differences, on data off the model
     /// (residuals of both signs), at interior points of the box, for every set of free
