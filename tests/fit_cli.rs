@@ -323,7 +323,7 @@ fn each_bad_input_gets_one_clear_error_and_no_output() {
         (
             "e_err_not_positive",
             format!("{head}{good}12.7,3.0,0.9,0\n"),
-            ":7: column 'e_err': '0' is out of range: expected an error of at least 5e-11",
+            ":7: column 'e_err': '0' is out of range: expected an error from 5e-11",
         ),
         (
             "missing_column",

@@ -15,8 +15,8 @@ use rand::SeedableRng;
 use rand::rngs::StdRng;
 use rand_distr::{Distribution, Normal};
 use restitution::contact::Material;
-use restitution::fit::dataset::E_ERR_MIN;
 use restitution::fit::dataset::pair_contact;
+use restitution::fit::dataset::{E_ERR_MAX, E_ERR_MIN};
 use restitution::fit::models::predict_e;
 use restitution::fit::{FitData, FitOptions, ModelKind, Observation, fit, fit_all};
 use restitution::models::viscoelastic::{ContactEnd, VmMethod};
@@ -168,6 +168,68 @@ fn tiny_errors_are_refused_and_the_smallest_accepted_ones_fit() {
     assert!(fit(&data, ModelKind::Vm, &FitOptions::default()).is_ok());
     let e = fit(&data, ModelKind::Vm, &ode).unwrap_err().to_string();
     assert!(e.contains("e_err") && e.contains("1e-8"), "{e}");
+}
+
+#[test]
+fn huge_errors_are_refused_and_the_largest_accepted_ones_count_alike_everywhere() {
+    // Fuzzed `fit` (seed 604, case 1309): a row with e = 1e300 and sigma_e = 1.1e299. Its
+    // weight 1/sigma^2 underflowed to 0 in the search, which saw chi2 = 4.77, while the polishes
+    // (residual / sigma) added its 81: the fit reported the grid point as "not converged" with
+    // region warnings quoting the other chi2. Errors above E_ERR_MAX (1e100) are refused; at
+    // 1e100 the row counts the same in the search and in the polishes, so every model ends
+    // converged on one chi2 (the Fig. 7-like rows alone, plus the huge row's constant
+    // ((1e150 - e)/1e100)^2 = 1e100 to 1e-16 of it).
+    let m = Material::preset("nylon").unwrap();
+    let mut obs: Vec<Observation> = (0..12)
+        .map(|i| Observation {
+            d_mm: [6.35, 12.7, 25.4][i % 3],
+            d2_mm: None,
+            v_n_m_s: 0.6 * 1.45f64.powi(i as i32),
+            e: 0.98 - 0.025 * i as f64,
+            e_err: Some(0.02),
+        })
+        .collect();
+    let huge = |e: f64, err: f64| Observation {
+        d_mm: 12.7,
+        d2_mm: None,
+        v_n_m_s: 3.0,
+        e,
+        e_err: Some(err),
+    };
+    for err in [E_ERR_MAX * (1.0 + 1e-15), 1.1e299, f64::MAX] {
+        let mut o = obs.clone();
+        o.push(huge(1e300, err));
+        let e = FitData::new(m, o).unwrap_err().to_string();
+        assert!(e.contains("e_err") && e.contains("1e100"), "{err}: {e}");
+    }
+    let base = fit_all(
+        &FitData::new(m, obs.clone()).unwrap(),
+        &ModelKind::ALL,
+        &FitOptions::default(),
+    )
+    .unwrap();
+    obs.push(huge(1e150, E_ERR_MAX));
+    let set = fit_all(
+        &FitData::new(m, obs).unwrap(),
+        &ModelKind::ALL,
+        &FitOptions::default(),
+    )
+    .unwrap();
+    for (f, b) in set.fits.iter().zip(&base.fits) {
+        assert!(
+            f.converged && f.global.certified,
+            "{}: {:?}",
+            f.model,
+            f.warnings
+        );
+        assert!(
+            ((f.chi2 - 1e100) / 1e100).abs() < 1e-12,
+            "{}: chi2 {} (without the row {})",
+            f.model,
+            f.chi2,
+            b.chi2
+        );
+    }
 }
 
 #[test]

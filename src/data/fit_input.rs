@@ -14,7 +14,7 @@
 use super::{DataError, DataFailure, Table};
 use crate::contact::Material;
 use crate::error::Num;
-use crate::fit::dataset::{E_ERR_MIN, FitData, Observation};
+use crate::fit::dataset::{E_ERR_MAX, E_ERR_MIN, FitData, Observation};
 use std::path::Path;
 
 /// Where the errors of e came from.
@@ -158,13 +158,14 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
             (Some(c), _) => Some(table.number_where(
                 row,
                 c,
-                |x| x >= E_ERR_MIN,
-                "an error of at least 5e-11 (1000 times the accuracy e is computed to)",
+                |x| (E_ERR_MIN..=E_ERR_MAX).contains(&x),
+                "an error from 5e-11 (1000 times the accuracy e is computed to) to 1e100 (beyond, \
+                 its weight 1/e_err^2 underflows)",
             )?),
             (None, Some(c)) => {
                 let dv = table.number_where(row, c, |x| x > 0.0, "a speed error > 0 (m/s)")?;
                 let s = 2.0 * e * dv / v;
-                if !(s >= E_ERR_MIN && s.is_finite()) {
+                if !(E_ERR_MIN..=E_ERR_MAX).contains(&s) {
                     return Err(table.cell_error(
                         row,
                         c_e,
@@ -172,7 +173,9 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
                             "'{}' gives sigma_e = 2 e v_err / v_n = {}{}: give an e_err column",
                             table.shown(row, c_e),
                             Num(s),
-                            if s.is_finite() && s > 0.0 {
+                            if s.is_finite() && s > E_ERR_MAX {
+                                ", above 1e100 (its weight 1/sigma_e^2 would underflow)"
+                            } else if s.is_finite() && s > 0.0 {
                                 ", below 5e-11 (1000 times the accuracy e is computed to)"
                             } else {
                                 ""
@@ -241,14 +244,15 @@ mod tests {
     }
 
     #[test]
-    fn errors_below_what_e_is_computed_to_name_their_cell() {
+    fn errors_outside_the_accepted_range_name_their_cell() {
         // Given, and derived from v_err for an e of 1e-20: each below 5e-11.
         let text = "d_mm,v_n_m_s,e,e_err\n12.7,1.0,0.9,0.01\n12.7,2.0,0.8,1e-12\n";
         let err = parse_fit_csv("f.csv", text, nylon(), false).unwrap_err();
         assert_eq!(
             err.to_string(),
-            "f.csv:3: column 'e_err': '1e-12' is out of range: expected an error of at least \
-             5e-11 (1000 times the accuracy e is computed to)"
+            "f.csv:3: column 'e_err': '1e-12' is out of range: expected an error from 5e-11 \
+             (1000 times the accuracy e is computed to) to 1e100 (beyond, its weight 1/e_err^2 \
+             underflows)"
         );
         let text = "d_mm,v_n_m_s,e,v_err_m_s\n12.7,1.0,0.9,0.04\n12.7,1.0,1e-20,0.5\n";
         let err = parse_fit_csv("f.csv", text, nylon(), false).unwrap_err();
@@ -257,10 +261,26 @@ mod tests {
             "f.csv:3: column 'e': '1e-20' gives sigma_e = 2 e v_err / v_n = 1e-20, below 5e-11 \
              (1000 times the accuracy e is computed to): give an e_err column"
         );
-        // At the floor (the messages quote it): accepted.
-        assert_eq!(E_ERR_MIN, 5e-11);
-        let text = "d_mm,v_n_m_s,e,e_err\n12.7,1.0,0.9,0.01\n12.7,2.0,0.8,5e-11\n";
+        // At the floor and the ceiling (the messages quote them): accepted.
+        assert_eq!((E_ERR_MIN, E_ERR_MAX), (5e-11, 1e100));
+        let text =
+            "d_mm,v_n_m_s,e,e_err\n12.7,1.0,0.9,0.01\n12.7,2.0,0.8,5e-11\n12.7,3.0,0.8,1e100\n";
         assert!(parse_fit_csv("f.csv", text, nylon(), false).is_ok());
+        // Above the ceiling, given or derived (fuzzed `fit`, seed 604, case 1309: e = 1e300).
+        let text = "d_mm,v_n_m_s,e,e_err\n12.7,1.0,0.9,0.01\n12.7,2.0,0.8,2e100\n";
+        let err = parse_fit_csv("f.csv", text, nylon(), false).unwrap_err();
+        assert!(
+            err.to_string()
+                .starts_with("f.csv:3: column 'e_err': '2e100' is out of range"),
+            "{err}"
+        );
+        let text = "d_mm,v_n_m_s,e,v_err_m_s\n12.7,1.0,0.9,0.04\n12.7,0.651,1e300,0.0362\n";
+        let err = parse_fit_csv("f.csv", text, nylon(), false).unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "f.csv:3: column 'e': '1e300' gives sigma_e = 2 e v_err / v_n = 1.1121351766513058e299, \
+             above 1e100 (its weight 1/sigma_e^2 would underflow): give an e_err column"
+        );
     }
 
     #[test]

@@ -84,9 +84,16 @@ pub fn pair_contact(material: Material, d_mm: f64, d2_mm: Option<f64>) -> Result
 /// accuracy of e computed with the master curve, 5e-11 (see there why).
 pub const E_ERR_MIN: f64 = ERROR_PER_ACCURACY * MASTER_ACCURACY;
 
+/// The largest error of e a row may have. The search weighs each point by 1/sigma^2 and the
+/// polishes by its residual divided by sigma: beyond about 1e154, 1/sigma^2 underflows to 0, and
+/// the two disagreed (a row with e = 1e300 and sigma_e = 1.1e299 added 81 to the polishes' chi2
+/// and nothing to the search's). 1e100 keeps every weight a normal double, far beyond any
+/// measurement of e.
+pub const E_ERR_MAX: f64 = 1e100;
+
 impl FitData {
-    /// Validates the observations (d > 0, v_n > 0, e >= 0 finite, e_err finite and at least
-    /// [`E_ERR_MIN`], either every row has an error or none has) and derives each pair's
+    /// Validates the observations (d > 0, v_n > 0, e >= 0 finite, e_err from [`E_ERR_MIN`] to
+    /// [`E_ERR_MAX`], either every row has an error or none has) and derives each pair's
     /// contact.
     pub fn new(material: Material, obs: Vec<Observation>) -> Result<FitData> {
         if obs.is_empty() {
@@ -109,13 +116,14 @@ impl FitData {
                 return Err(bad("e", o.e, "a finite number >= 0"));
             }
             if let Some(s) = o.e_err
-                && !(s.is_finite() && s >= E_ERR_MIN)
+                && !(E_ERR_MIN..=E_ERR_MAX).contains(&s)
             {
                 return Err(bad(
                     "e_err",
                     s,
-                    "a finite number of at least 5e-11 (1000 times the accuracy e is computed \
-                     to: below it the residual would be rounding)",
+                    "a number from 5e-11 (1000 times the accuracy e is computed to: below it the \
+                     residual would be rounding) to 1e100 (beyond it the weight 1/e_err^2 \
+                     underflows)",
                 ));
             }
             if let Some(d2) = o.d2_mm
