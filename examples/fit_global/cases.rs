@@ -36,6 +36,8 @@ impl Truth {
 pub struct Case {
     pub seed: u64,
     pub truth: Truth,
+    /// The contact-end rule of the fits (the synthetic sets: the overlap rule).
+    pub rule: ContactEnd,
     pub data: FitData,
     pub description: String,
 }
@@ -157,6 +159,7 @@ pub fn make_case(seed: u64) -> Case {
     Case {
         seed,
         truth,
+        rule,
         data: FitData::new(material, obs).expect("valid data"),
         description,
     }

@@ -9,9 +9,9 @@
 //!
 //! `--dumped DIR` checks data files instead: the `fit` cases the fuzzer wrote with `--dump DIR`
 //! (`DIR/case-I/args.txt` and the file it names), each read as the command line would read it
-//! (its material flags and `--strict`); files it refuses, and cases with `--exact` or the force
-//! rule, are skipped. The fuzzer's inputs are far from the synthetic sets: a few rows, speeds of
-//! 1e-300 or 1e300 m/s, duplicated rows, extreme error bars.
+//! (its material flags, `--contact-end` and `--strict`); files it refuses, and cases with
+//! `--exact`, are skipped. The fuzzer's inputs are far from the synthetic sets: a few rows,
+//! speeds of 1e-300 or 1e300 m/s, duplicated rows, extreme materials and error bars.
 //!
 //! **Data sets** (seed s, rand's StdRng): a material (nu uniform in 0.2-0.49, rho log-uniform in
 //! 900-8000 kg/m^3, Y log-uniform in 1e8-2e11 Pa), one to four diameters (1-50 mm) as identical
@@ -43,6 +43,7 @@ mod reference;
 
 use cases::Case;
 use reference::Outcome;
+use restitution::models::viscoelastic::ContactEnd;
 
 fn main() {
     let raw: Vec<String> = std::env::args().skip(1).collect();
@@ -92,7 +93,7 @@ fn dumped(dir: &std::path::Path) {
         found.len()
     );
     let results = in_threads(cases, |case| {
-        let out = reference::check_data(case.seed, case.truth, &case.data);
+        let out = reference::check_data(case.seed, case.truth, &case.data, case.rule);
         (case, out)
     });
     report(
@@ -112,9 +113,11 @@ fn read_case(i: u64, dir: &std::path::Path) -> Option<Case> {
             .position(|a| *a == flag)
             .and_then(|k| args.get(k + 1).copied())
     };
-    if value("--contact-end").is_some_and(|r| r != "overlap") {
-        return None;
-    }
+    let rule = match value("--contact-end") {
+        None | Some("overlap") => ContactEnd::Overlap,
+        Some("force") => ContactEnd::Force,
+        Some(_) => return None,
+    };
     let material = match value("--material") {
         Some(name) => restitution::contact::Material::preset(name)?,
         None => restitution::contact::Material::new(
@@ -131,6 +134,7 @@ fn read_case(i: u64, dir: &std::path::Path) -> Option<Case> {
     Some(Case {
         seed: i,
         truth: cases::Truth::File,
+        rule,
         data: input.data,
         description: format!("{}", dir.display()),
     })

@@ -13,21 +13,13 @@ use restitution::models::viscoelastic::master::KAPPA_MAX;
 use restitution::models::viscoelastic::{ContactEnd, VmMethod};
 
 /// chi2 of `kind` at physical parameters `p`, point by point through `predict_e`.
-fn chi2_direct(data: &FitData, kind: ModelKind, p: &[f64]) -> f64 {
+fn chi2_direct(data: &FitData, kind: ModelKind, p: &[f64], rule: ContactEnd) -> f64 {
     data.obs
         .iter()
         .zip(&data.contacts)
         .enumerate()
         .map(|(i, (o, c))| {
-            let m = predict_e(
-                kind,
-                c,
-                o.v_n_m_s,
-                p,
-                ContactEnd::Overlap,
-                &VmMethod::Master,
-            )
-            .unwrap_or(f64::NAN);
+            let m = predict_e(kind, c, o.v_n_m_s, p, rule, &VmMethod::Master).unwrap_or(f64::NAN);
             ((o.e - m) / data.sigma(i)).powi(2)
         })
         .sum()
@@ -112,6 +104,7 @@ fn powerlaw_exponent_box(data: &FitData) -> ((f64, f64), (f64, f64)) {
 struct Chi2Problem<'a> {
     data: &'a FitData,
     kind: ModelKind,
+    rule: ContactEnd,
     bx: Vec<(f64, f64)>,
 }
 
@@ -133,7 +126,7 @@ impl CostFunction for Chi2Problem<'_> {
                 }
             })
             .collect();
-        let c = chi2_direct(self.data, self.kind, &p);
+        let c = chi2_direct(self.data, self.kind, &p, self.rule);
         Ok(if c.is_nan() { f64::INFINITY } else { c })
     }
 }
@@ -142,6 +135,7 @@ impl CostFunction for Chi2Problem<'_> {
 fn nelder_mead(
     data: &FitData,
     kind: ModelKind,
+    rule: ContactEnd,
     bx: &[(f64, f64)],
     start: &[f64],
     step: &[f64],
@@ -155,6 +149,7 @@ fn nelder_mead(
     let problem = Chi2Problem {
         data,
         kind,
+        rule,
         bx: bx.to_vec(),
     };
     let solver = NelderMead::new(simplex)
@@ -227,16 +222,15 @@ fn axis(lo: f64, hi: f64, n: usize) -> Vec<f64> {
 }
 
 /// The reference minimum of chi2 for `kind` (see the module doc).
-pub fn reference_chi2(data: &FitData, kind: ModelKind) -> f64 {
-    reference(data, kind).0
+pub fn reference_chi2(data: &FitData, kind: ModelKind, rule: ContactEnd) -> f64 {
+    reference(data, kind, rule).0
 }
 
 /// The reference minimum and where it is (internal coordinates, clamped into the box).
-pub fn reference(data: &FitData, kind: ModelKind) -> (f64, Vec<f64>) {
+pub fn reference(data: &FitData, kind: ModelKind, rule: ContactEnd) -> (f64, Vec<f64>) {
     let bx = reference_box(data, kind);
     let n = data.len();
     let w: Vec<f64> = (0..n).map(|i| data.sigma(i).powi(-2)).collect();
-    let rule = ContactEnd::Overlap;
     let m = VmMethod::Master;
     let vm_row = |t: f64| -> Vec<f64> {
         data.obs
@@ -335,7 +329,7 @@ pub fn reference(data: &FitData, kind: ModelKind) -> (f64, Vec<f64>) {
         let start: Vec<f64> = (0..dims.len())
             .map(|k| axes[k][idx / strides[k] % dims[k]])
             .collect();
-        let (v, p) = nelder_mead(data, kind, &bx, &start, &steps);
+        let (v, p) = nelder_mead(data, kind, rule, &bx, &start, &steps);
         if v < best {
             best = v;
             at = p.iter().zip(&bx).map(|(x, b)| x.clamp(b.0, b.1)).collect();
@@ -396,11 +390,11 @@ impl Outcome {
 
 /// Fits every model to the case and compares with the reference.
 pub fn check(case: &Case) -> Vec<Outcome> {
-    check_data(case.seed, case.truth, &case.data)
+    check_data(case.seed, case.truth, &case.data, ContactEnd::Overlap)
 }
 
-/// As [`check`], for any data (their e_vm by the overlap rule).
-pub fn check_data(seed: u64, truth: Truth, data: &FitData) -> Vec<Outcome> {
+/// As [`check`], for any data and either contact-end rule.
+pub fn check_data(seed: u64, truth: Truth, data: &FitData, rule: ContactEnd) -> Vec<Outcome> {
     let rounding: f64 = (0..data.len())
         .map(|i| (8.0 * f64::EPSILON * data.obs[i].e.max(1.0) / data.sigma(i)).powi(2))
         .sum();
@@ -408,8 +402,15 @@ pub fn check_data(seed: u64, truth: Truth, data: &FitData) -> Vec<Outcome> {
         .iter()
         .filter(|k| data.len() > k.n_params())
         .map(|&kind| {
-            let r = fit(data, kind, &FitOptions::default());
-            let ref_chi2 = reference_chi2(data, kind);
+            let r = fit(
+                data,
+                kind,
+                &FitOptions {
+                    rule,
+                    ..FitOptions::default()
+                },
+            );
+            let ref_chi2 = reference_chi2(data, kind, rule);
             match r {
                 Ok(f) => Outcome {
                     seed,

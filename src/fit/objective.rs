@@ -376,8 +376,8 @@ fn search_box(
             if ends != [-10.0, 10.0, -10.0, 10.0] {
                 warnings.push(format!(
                     "powerlaw: exponents searched in a in [{:.3}, {:.3}], b in [{:.3}, {:.3}] \
-                     instead of [-10, 10]: beyond, A (d/10 mm)^(-a) (v/1 m/s)^b would leave \
-                     [1e-304, 1e130] at some point of the data",
+                     instead of [-10, 10]: a box where 1 - e = A (d/10 mm)^(-a) (v/1 m/s)^b \
+                     stays within [1e-304, 1e130] at every point of the data",
                     ends[0], ends[1], ends[2], ends[3]
                 ));
             }
