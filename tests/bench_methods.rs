@@ -540,10 +540,15 @@ fn fit_accuracy_picks_the_cheapest_method_that_meets_the_rule() {
     assert!((f.eta_ref - 247.24).abs() < 0.1, "{}", f.eta_ref);
     assert!((f.threshold - SIGMA_FRACTION * f.min_sigma).abs() < 1e-18);
     // Master curve: model error at rounding (the table's 2.4e-15 bar), eta as the reference's to
-    // the fit's own convergence (measured 4e-14); it meets the rule and is the cheapest.
+    // what chi2's values can resolve: the two models differ by 4e-16 in e, so their chi2 by
+    // about 2 sum w |r| 4e-16 = 2.4e-12 (plus rounding, 1e-13), and a minimum located from values
+    // that noisy moves by sd sqrt(2.5e-12) = 1.2e-8 of eta (sd = 1.8 / 247 = 0.0074, eta's
+    // relative standard error from the curvature alone, stderr_abs): measured 1.1e-8 since
+    // Brent's tolerance counts from the bracket's middle (4e-14 before, when both fits stopped at
+    // the same point of a coarser tolerance, 8e-8 in ln eta). 1e-7 allows eight times that.
     let master = &f.rows[0];
     assert!(master.model_error < 3e-15, "{master:?}");
-    assert!(master.eta_rel_error < 1e-10, "{master:?}");
+    assert!(master.eta_rel_error < 1e-7, "{master:?}");
     assert!(master.meets);
     assert_eq!(f.default_row, Some(0));
     // Dop853 at 1e-8: measured model error 1.2e-9, eta error 6.4e-9 (drift bound 10x).
