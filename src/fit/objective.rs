@@ -372,7 +372,7 @@ fn search_box(
                     ]
                 })
                 .collect();
-            let ends = powerlaw_exponent_ends(&x, a_hi, a_lo)?;
+            let ends = powerlaw_exponent_ends(&x, a_lo, a_hi)?;
             if ends != [-10.0, 10.0, -10.0, 10.0] {
                 warnings.push(format!(
                     "powerlaw: exponents searched in a in [{:.3}, {:.3}], b in [{:.3}, {:.3}] \
@@ -400,7 +400,7 @@ fn search_box(
 /// 1e-300 m/s limits b from below to about 0.42 (exp(-0.42 x -691) reaches 1e126) but from
 /// above only to about 1 (reaching 1e-300): a box symmetric in |a| and |b| would stop both at
 /// 0.42 and miss the data's b = 0.45.
-fn powerlaw_exponent_ends(x: &[[f64; 2]], ln_a_hi: f64, ln_a_lo: f64) -> Result<[f64; 4]> {
+fn powerlaw_exponent_ends(x: &[[f64; 2]], ln_a_lo: f64, ln_a_hi: f64) -> Result<[f64; 4]> {
     let up = POWERLAW_MAX_EXPONENT - ln_a_hi;
     let down = POWERLAW_MIN_EXPONENT + ln_a_lo;
     let n = x.len() as f64;
@@ -462,7 +462,7 @@ mod tests {
             .map(|&(d, v): &(f64, f64)| [(d / 10.0).ln(), v.ln()])
             .collect();
         assert_eq!(
-            powerlaw_exponent_ends(&x, ln_a_hi, ln_a_lo).unwrap(),
+            powerlaw_exponent_ends(&x, ln_a_lo, ln_a_hi).unwrap(),
             [-10.0, 10.0, -10.0, 10.0]
         );
         // One speed of 1e-300 m/s among ordinary ones: b is held from below by that point's
@@ -472,7 +472,7 @@ mod tests {
         // others' about +175 hold b_hi only to about 1.7).
         let mut x = x;
         x.push([2.54f64.ln(), 1e-300f64.ln()]);
-        let ends = powerlaw_exponent_ends(&x, ln_a_hi, ln_a_lo).unwrap();
+        let ends = powerlaw_exponent_ends(&x, ln_a_lo, ln_a_hi).unwrap();
         let reach = 2.54f64.ln() + 300.0 * 10f64.ln();
         assert!(
             (ends[2] + (300.0 - ln_a_hi) / reach).abs() < 1e-15,
@@ -505,7 +505,7 @@ mod tests {
                     ]
                 })
                 .collect();
-            let e = powerlaw_exponent_ends(&x, ln_a_hi, ln_a_lo).unwrap();
+            let e = powerlaw_exponent_ends(&x, ln_a_lo, ln_a_hi).unwrap();
             narrowed += usize::from(e != [-10.0, 10.0, -10.0, 10.0]);
             let mean = [0, 1].map(|k| x.iter().map(|p| p[k]).sum::<f64>() / n as f64);
             for p in &x {
