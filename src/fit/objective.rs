@@ -11,7 +11,7 @@
 //!   yields (V_Y >= 1.5 v for every point: the plateau where sigma_y stops mattering);
 //! - powerlaw: A in [1e-9, 1e3], a and b in [-10, 10], each end of the exponents narrowed (with a
 //!   warning) for data so extreme that 1 - e = A (d/10 mm)^(-a) (v/1 m/s)^b would leave
-//!   [1e-304, 1e130] at some point inside the box ([`powerlaw_exponent_ends`]).
+//!   [1e-304, 1e130] at some point inside the box (`powerlaw_exponent_ends`).
 //!
 //! **Chi2 scale** s (one convention for `stderr` and the intervals): weighted fits use
 //! s = max(1, chi2/dof), the Particle Data Group's scale-factor rule (errors as given, unless the
