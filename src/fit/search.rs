@@ -256,7 +256,7 @@ fn run<L: Landscape>(
     };
     if !first.is_finite() {
         return Err(Error::InvalidParameter {
-            name: "smallest chi2 on the search grid (the squares overflow: e_err too small?)",
+            name: "smallest chi2 on the search grid (the squares overflow: e far from the model, or e_err too small?)",
             value: first,
             expected: "a finite number",
         });

@@ -35,7 +35,7 @@ pub(super) fn summarise(
     let chi2 = chi2_points + obj.chi2_offset;
     if !chi2.is_finite() {
         return Err(Error::InvalidParameter {
-            name: "chi2 at the best fit (the squares overflow: e_err too small?)",
+            name: "chi2 at the best fit (the squares overflow: e far from the model, or e_err too small?)",
             value: chi2,
             expected: "a finite number",
         });
