@@ -85,23 +85,29 @@ fn a_polish_that_ends_on_the_best_grid_point_is_converged() {
     // one ulp above it (99.91209641685566 against 99.91209641685565), so the fit reported the
     // grid point as not converged, with a warning printing both as 99.91. A difference within
     // the rounding of the sums is no difference.
-    let case = cases::make_case(465);
     for kind in [ModelKind::Min, ModelKind::Product] {
-        let r = fit(&case.data, kind, &FitOptions::default()).unwrap();
-        let reference = reference::reference_chi2(&case.data, kind, ContactEnd::Overlap);
-        assert!(
-            r.chi2 <= reference * (1.0 + 1e-6),
-            "{kind}: fit {} reference {reference}",
-            r.chi2
-        );
-        assert!(
-            r.converged && r.global.certified && r.warnings.is_empty(),
-            "{kind}: converged {} certified {} {:?}",
-            r.converged,
-            r.global.certified,
-            r.warnings
-        );
+        converged_at_the_reference(465, kind);
     }
+}
+
+/// Seed `seed`'s fit by `kind`: at most 1e-6 relative above the reference, converged,
+/// certified, without a warning.
+fn converged_at_the_reference(seed: u64, kind: ModelKind) {
+    let case = cases::make_case(seed);
+    let r = fit(&case.data, kind, &FitOptions::default()).unwrap();
+    let reference = reference::reference_chi2(&case.data, kind, ContactEnd::Overlap);
+    assert!(
+        r.chi2 <= reference * (1.0 + 1e-6),
+        "seed {seed} {kind}: fit {} reference {reference}",
+        r.chi2
+    );
+    assert!(
+        r.converged && r.global.certified && r.warnings.is_empty(),
+        "seed {seed} {kind}: converged {} certified {} {:?}",
+        r.converged,
+        r.global.certified,
+        r.warnings
+    );
 }
 
 #[test]
@@ -113,21 +119,7 @@ fn a_polish_that_reaches_the_grid_point_within_the_models_accuracy_is_converged(
     // rounding (up to 30 u at |b ln v| ~ 12) a relative error of 1 - e, beyond the rounding of
     // the sums alone (1.7e-13), so the fit reported the grid point as not converged. Within
     // what the model's accuracy allows, the polish reached it.
-    let case = cases::make_case(2043);
-    let r = fit(&case.data, ModelKind::PowerLaw, &FitOptions::default()).unwrap();
-    let reference = reference::reference_chi2(&case.data, ModelKind::PowerLaw, ContactEnd::Overlap);
-    assert!(
-        r.chi2 <= reference * (1.0 + 1e-6),
-        "fit {} reference {reference}",
-        r.chi2
-    );
-    assert!(
-        r.converged && r.global.certified && r.warnings.is_empty(),
-        "converged {} certified {} {:?}",
-        r.converged,
-        r.global.certified,
-        r.warnings
-    );
+    converged_at_the_reference(2043, ModelKind::PowerLaw);
 }
 
 #[test]

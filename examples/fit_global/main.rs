@@ -189,9 +189,7 @@ fn report(results: &[(Case, Vec<Outcome>)], what: &str) {
                 failed += 1;
                 e.1 += 1;
                 refused += o.error.is_some() as usize;
-                let explained = o.error.is_none()
-                    && o.certified
-                    && o.fit_chi2 - o.ref_chi2 <= o.gap + 1e-12 * o.fit_chi2 + o.rounding;
+                let explained = o.within_gap();
                 short += o.short_in_fine_cells() as usize;
                 within_gap += explained as usize;
                 println!(

@@ -376,10 +376,15 @@ impl Outcome {
     /// possible; without fine cells it is a false certificate, the worst outcome: a wrong
     /// number that says it is right.
     pub fn certificate_holds(&self) -> bool {
-        let excess = self.fit_chi2 - self.ref_chi2;
-        !self.certified
-            || excess <= self.gap + 1e-12 * self.fit_chi2 + self.rounding
-            || self.fine_cells > 0
+        !self.certified || self.within_gap() || self.fine_cells > 0
+    }
+
+    /// A certified fit above the reference by no more than the gap it states (plus 1e-12 of its
+    /// chi2 and the rounding of chi2).
+    pub fn within_gap(&self) -> bool {
+        self.error.is_none()
+            && self.certified
+            && self.fit_chi2 - self.ref_chi2 <= self.gap + 1e-12 * self.fit_chi2 + self.rounding
     }
 
     /// A certified fit with fine cells, above the reference by more than the pass allows.
