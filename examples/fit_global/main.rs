@@ -72,8 +72,11 @@ fn main() {
 /// The `fit` cases of a fuzzer's dump (see the module doc): each case's number stands for the
 /// seed in the report.
 fn dumped(dir: &std::path::Path) {
-    let mut found: Vec<(u64, std::path::PathBuf)> = std::fs::read_dir(dir)
-        .expect("the dump directory")
+    let entries = std::fs::read_dir(dir).unwrap_or_else(|e| {
+        eprintln!("fit_global: --dumped {}: {e}", dir.display());
+        std::process::exit(2)
+    });
+    let mut found: Vec<(u64, std::path::PathBuf)> = entries
         .filter_map(|e| {
             let p = e.ok()?.path();
             let i = p
