@@ -387,6 +387,25 @@ fn bad_input_is_one_line_naming_the_place() {
             "powerlaw",
         ],
         vec!["simulate", "--out", s(&out)],
+        // A frame interval of inf s panicked; a subpixel of 0 m made tracks `kinematics` refuses.
+        vec![
+            "simulate",
+            "--material",
+            "nylon",
+            "--out",
+            s(&out),
+            "--fps",
+            "5e-324",
+        ],
+        vec![
+            "simulate",
+            "--material",
+            "nylon",
+            "--out",
+            s(&out),
+            "--fov-m",
+            "5e-324",
+        ],
         // V_Y = 1e-345 m/s underflows: an error naming sigma_y (it made e = 0 for every
         // collision, silently).
         vec![
@@ -407,6 +426,9 @@ fn bad_input_is_one_line_naming_the_place() {
         assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
         if args.contains(&"1e-130") {
             assert!(err.contains("sigma_y = 1e-130 Pa"), "{err}");
+        }
+        if args.contains(&"5e-324") {
+            assert!(err.contains(&format!("{} 5e-324", args[5])), "{err}");
         }
         assert!(!out.exists(), "{args:?} wrote output");
     }

@@ -133,7 +133,7 @@ fn seeded_bench_flags() {
 #[test]
 fn cases_the_larger_runs_found() {
     let base = Sheet::parse(&fig7());
-    let found: [(Command_, u64, u64); 16] = [
+    let found: [(Command_, u64, u64); 17] = [
         (Command_::Fit, 202, 598),
         (Command_::Fit, 401, 522),
         (Command_::Fit, 2, 985),
@@ -153,6 +153,9 @@ fn cases_the_larger_runs_found() {
         (Command_::Export, 2, 535),
         // kinematics --fov-m 5e-324: a subpixel of 0 m, and the noise printed as inf subpixels.
         (Command_::Kinematics, 1, 356),
+        // simulate --fps 5e-324: a frame interval of inf s, and a panic drawing the clock's
+        // phase in [0, inf).
+        (Command_::Simulate, 614, 52),
     ];
     let cases: Vec<Case> = found
         .iter()

@@ -20,6 +20,7 @@ use super::{CliResult, MaterialArgs};
 use rand::SeedableRng;
 use rand::rngs::StdRng;
 use restitution::contact::Pair;
+use restitution::data::frames::job::{FPS_RANGE, PIXEL_M_RANGE};
 use restitution::data::report::camera_study::camera_study_csv;
 use restitution::data::tracks::{CollisionTrack, write_tracks};
 use restitution::data::{CsvOut, fmt_num, write_all_atomic};
@@ -174,7 +175,13 @@ pub fn run(args: Args) -> CliResult {
         (-1.0..=1.0).contains(&args.beta0),
         "a number in [-1, 1]",
     )?;
-    check("--fps", args.fps, args.fps > 0.0, "a frame rate > 0")?;
+    let (lo, hi) = FPS_RANGE;
+    check(
+        "--fps",
+        args.fps,
+        (lo..=hi).contains(&args.fps),
+        &format!("a frame rate in [{}, {}] per s", fmt_num(lo), fmt_num(hi)),
+    )?;
     check("--fov-m", args.fov_m, args.fov_m > 0.0, "a width > 0 (m)")?;
     check(
         "--subpixel-expansion",
@@ -182,6 +189,20 @@ pub fn run(args: Args) -> CliResult {
         args.subpixel_expansion >= 1.0,
         "a factor >= 1",
     )?;
+    // The subpixel `kinematics` will read these tracks with: the same range it accepts.
+    let (lo, hi) = PIXEL_M_RANGE;
+    let subpixel_m = args.fov_m / f64::from(args.pixels_x) / args.subpixel_expansion;
+    if args.pixels_x > 0 && !(lo..=hi).contains(&subpixel_m) {
+        return Err(format!(
+            "--fov-m {} / --pixels-x {} / --subpixel-expansion {} = {} m: expected a subpixel size in [{}, {}] m",
+            fmt_num(args.fov_m),
+            args.pixels_x,
+            fmt_num(args.subpixel_expansion),
+            fmt_num(subpixel_m),
+            fmt_num(lo),
+            fmt_num(hi)
+        ));
+    }
     check(
         "--s-subpixels",
         args.s_subpixels,
