@@ -137,3 +137,40 @@ fn the_subpixel_size_is_checked_given_or_derived() {
         );
     }
 }
+
+#[test]
+fn the_files_say_how_many_collisions_were_skipped() {
+    // The committed collision and a copy of it with one frame before and after the contact: the
+    // copy cannot be measured, is skipped with a warning, and every file written says so.
+    let full = tracks();
+    let mut lines = full.lines();
+    let head = lines.next().unwrap();
+    let rows: Vec<&str> = lines.collect();
+    let short: Vec<String> = [rows[0], rows[rows.len() - 1]]
+        .iter()
+        .map(|l| l.replacen("shot_7", "short", 1))
+        .collect();
+    let text = format!("{head}\n{}\n{}\n", rows.join("\n"), short.join("\n"));
+    let dir = std::env::temp_dir().join(format!("restitution-kin-skip-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("tracks.csv");
+    std::fs::write(&path, text).unwrap();
+    let out = dir.join("out");
+    let o = Command::new(bin())
+        .args(["kinematics", path.to_str().unwrap(), "--material", "nylon"])
+        .args(["--out", out.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("skipped") && err.contains("'short'"), "{err}");
+    for f in ["fit_input.csv", "kinematics.csv", "walton_input.csv"] {
+        let text = std::fs::read_to_string(out.join(f)).unwrap();
+        let first = text.lines().next().unwrap();
+        assert!(
+            first.starts_with('#') && first.contains("; 1 of 2 collisions skipped"),
+            "{f}: {first}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

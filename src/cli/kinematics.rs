@@ -189,12 +189,23 @@ pub fn run(args: Args) -> CliResult {
                 }
         ));
     }
+    // The files say what they leave out: skipped collisions are often the fast ones (too few
+    // frames), so a fit of what is left sees a narrower range of speeds than was filmed.
     let comment = format!(
-        "made by restitution kinematics from {shown} ({})",
+        "made by restitution kinematics from {shown} ({}){}",
         if args.fixed_gravity {
             "fixed-gravity fits"
         } else {
             "free quadratic fits"
+        },
+        if skipped.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; {} of {} collisions skipped: they cannot be measured (the command's warnings say why)",
+                skipped.len(),
+                rows.len() + skipped.len()
+            )
         }
     );
     if let Some(dir) = &args.out {
