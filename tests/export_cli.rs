@@ -655,3 +655,82 @@ fn verify_without_lmp_says_so() {
     assert!(stderr.contains("lmp (LAMMPS) is not on PATH"), "{stderr}");
     assert_eq!(std::fs::read_dir(&out).unwrap().count(), 0);
 }
+
+/// Without `--d-mm` the scene is the one measured: both spheres of an unequal pair (params.json
+/// once listed only the first, so 10 mm on 20 mm data exported a scene of 10 mm spheres alone)
+/// and the wall of sphere-on-wall data. Given sizes replace the measured scene, wall included.
+#[test]
+fn the_default_scene_is_the_measured_one() {
+    let dir = scratch("scene");
+    let mut csv = String::from("d_mm,d2_mm,v_n_m_s,e,e_err\n");
+    for k in 0..8 {
+        let v = 0.5 * 1.5f64.powi(k);
+        csv += &format!("10,20,{v},{},0.02\n", 0.95 - 0.02 * k as f64);
+    }
+    let data = write(&dir, "unequal.csv", &csv);
+    let fit_dir = dir.join("fit");
+    let fitted = |data: &str, out: &Path| {
+        let r = run(&[
+            "fit",
+            data,
+            "--material",
+            "nylon",
+            "--model",
+            "vm",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(r.ok, "{}", r.stderr);
+        r.stdout
+    };
+    let text = fitted(&data, &fit_dir);
+    assert!(text.contains("8 points, pairs: 10 mm on 20 mm;"), "{text}");
+    let params = fit_dir.join("params.json");
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&params).unwrap()).unwrap();
+    assert_eq!(doc["data"]["diameters_mm"], serde_json::json!([10.0, 20.0]));
+    assert_eq!(doc["data"]["wall"], serde_json::json!(false));
+    let export = |params: &Path, extra: &[&str]| {
+        let mut args = vec!["export", params.to_str().unwrap(), "--engine", "lammps"];
+        args.extend(["--model", "vm"]);
+        args.extend(extra);
+        let r = run(&args);
+        assert!(r.ok, "{}", r.stderr);
+        r.stdout
+    };
+    let out = export(&params, &[]);
+    assert!(
+        out.contains("scene: type 1 = 10 mm, type 2 = 20 mm\n"),
+        "{out}"
+    );
+    assert!(out.contains("pair_coeff 1 2 "), "{out}");
+    // The shipped wall example: 12.7 mm on a wall.
+    let wall_dir = dir.join("wall");
+    let text = fitted("data/wall_example.csv", &wall_dir);
+    assert!(
+        text.contains("15 points, pairs: 12.7 mm on wall;"),
+        "{text}"
+    );
+    let params = wall_dir.join("params.json");
+    let out = export(&params, &[]);
+    assert!(
+        out.contains("scene: type 1 = 12.7 mm, and walls\n"),
+        "{out}"
+    );
+    assert!(out.contains("wall/gran"), "{out}");
+    let out = export(&params, &["--d-mm", "5"]);
+    assert!(out.contains("scene: type 1 = 5 mm\n"), "{out}");
+    // A params.json from before the field reads as no wall; a wrong one is one clear line.
+    let mut doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&params).unwrap()).unwrap();
+    doc["data"].as_object_mut().unwrap().remove("wall");
+    let old = write(&dir, "old.json", &doc.to_string());
+    let out = export(Path::new(&old), &[]);
+    assert!(out.contains("scene: type 1 = 12.7 mm\n"), "{out}");
+    doc["data"]["wall"] = serde_json::json!("yes");
+    let bad = write(&dir, "bad.json", &doc.to_string());
+    refuses(
+        &["export", &bad, "--engine", "lammps", "--model", "vm"],
+        "field 'data.wall' is \"yes\", expected true or false",
+    );
+}

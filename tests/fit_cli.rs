@@ -128,7 +128,10 @@ fn json_shape_is_stable() {
             "skipped_models"
         ]
     );
-    assert_eq!(keys(&v["data"]), ["path", "n", "diameters_mm", "errors"]);
+    assert_eq!(
+        keys(&v["data"]),
+        ["path", "n", "diameters_mm", "wall", "errors"]
+    );
     assert_eq!(
         keys(&v["material"]),
         ["youngs_pa", "poisson", "density_kg_m3"]

@@ -43,6 +43,8 @@ pub struct FitParamsFile {
     pub material: Material,
     pub contact_end: ContactEnd,
     pub diameters_mm: Vec<f64>,
+    /// Whether the fit data include a sphere on a wall (absent in files before the field: no).
+    pub wall: bool,
     pub preferred: Option<String>,
     pub fits: Vec<FitEntry>,
 }
@@ -165,6 +167,17 @@ fn params_from_value(p: String, v: Value) -> Result<FitParamsFile, DataError> {
             ));
         }
     };
+    let wall = match v.get("data").and_then(|d| d.get("wall")) {
+        None => false,
+        Some(Value::Bool(b)) => *b,
+        Some(x) => {
+            return Err(err(
+                p,
+                DataFailure::Value,
+                format!("field 'data.wall' is {x}, expected true or false"),
+            ));
+        }
+    };
     let preferred = v
         .get("preferred")
         .and_then(|x| x.as_str())
@@ -229,6 +242,7 @@ fn params_from_value(p: String, v: Value) -> Result<FitParamsFile, DataError> {
         material,
         contact_end,
         diameters_mm,
+        wall,
         preferred,
         fits,
     })

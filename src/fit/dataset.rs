@@ -178,12 +178,32 @@ impl FitData {
         groups
     }
 
-    /// Distinct first-sphere diameters, ascending, mm.
+    /// Distinct diameters of every sphere of the pairs (the second sphere's too: a wall is not a
+    /// sphere), ascending, mm: the sizes a simulation of the measured scene holds.
     pub fn diameters_mm(&self) -> Vec<f64> {
-        let mut d: Vec<f64> = self.obs.iter().map(|o| o.d_mm).collect();
+        let mut d: Vec<f64> = self
+            .obs
+            .iter()
+            .flat_map(|o| [Some(o.d_mm), o.d2_mm.filter(|d2| d2.is_finite())])
+            .flatten()
+            .collect();
         d.sort_by(f64::total_cmp);
         d.dedup();
         d
+    }
+
+    /// Whether some rows are a sphere on a wall.
+    pub fn on_wall(&self) -> bool {
+        self.obs
+            .iter()
+            .any(|o| o.d2_mm.is_some_and(f64::is_infinite))
+    }
+
+    /// Whether every row is a pair of identical spheres.
+    pub fn identical_pairs(&self) -> bool {
+        self.obs
+            .iter()
+            .all(|o| o.d2_mm.is_none_or(|d2| d2 == o.d_mm))
     }
 }
 
@@ -317,6 +337,20 @@ mod tests {
         assert_eq!(g[1].indices, vec![0, 3]);
         assert_eq!(g[2].label(), "2 mm on wall");
         assert_eq!(d.diameters_mm(), vec![1.0, 2.0]);
+        assert!(d.on_wall() && !d.identical_pairs());
+        // The second sphere of an unequal pair is a size of the scene too.
+        let mut unequal = obs(1.0, None);
+        unequal.d2_mm = Some(3.0);
+        let u = FitData::new(m, vec![unequal, obs(1.0, None)]).unwrap();
+        assert_eq!(u.diameters_mm(), vec![1.0, 3.0]);
+        assert!(!u.on_wall() && !u.identical_pairs());
+        let mut same = obs(2.0, None);
+        same.d2_mm = Some(2.0);
+        assert!(
+            FitData::new(m, vec![same, obs(1.0, None)])
+                .unwrap()
+                .identical_pairs()
+        );
         // A wall's contact has R~ = R_1 (docs/physics.md §1).
         assert_eq!(d.contacts[2].r_eff_m, 1e-3);
     }

@@ -105,6 +105,8 @@ pub struct FittedLaw {
     pub material: Material,
     /// The fit data's diameters, mm (empty when the law was given as numbers).
     pub diameters_mm: Vec<f64>,
+    /// Whether the fit data include a sphere on a wall.
+    pub wall: bool,
     /// Where the law came from, for the report and the files' comments (worded alike for every
     /// front end, so the files do not depend on which one ran).
     pub source: String,
@@ -131,6 +133,7 @@ impl FittedLaw {
             curve,
             material: file.material,
             diameters_mm: file.diameters_mm.clone(),
+            wall: file.wall,
             source: format!("{} (model {})", file.path, entry.model),
             shown: format!("{} (model {})", file.path, entry.model),
             warnings,
@@ -189,6 +192,7 @@ impl FittedLaw {
             curve,
             material,
             diameters_mm: Vec::new(),
+            wall: false,
             source: "the numbers given".into(),
             shown: [(n_eta.as_str(), eta), (n_sigma.as_str(), sigma_y_pa)]
                 .iter()
@@ -380,10 +384,12 @@ pub fn export(law: &FittedLaw, o: &ExportOptions) -> Result<Exported, ExportErro
         )
         .into());
     }
+    // Without sizes given, the scene is the one measured: its spheres, and its wall if any.
+    let wall = o.wall || (o.d_mm.is_empty() && law.wall);
     let scene = Scene::new(
         law.material,
         sizes_mm.iter().map(|d| d * 1e-3).collect(),
-        o.wall,
+        wall,
     )
     .map_err(|source| ExportError::Law {
         context: Some(name("d_mm")),

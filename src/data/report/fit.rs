@@ -150,6 +150,7 @@ pub fn to_json(ctx: &ReportContext, set: &FitSet) -> Value {
             "path": ctx.path,
             "n": ctx.data.len(),
             "diameters_mm": ctx.data.diameters_mm(),
+            "wall": ctx.data.on_wall(),
             "errors": ctx.error_source,
         },
         "material": {

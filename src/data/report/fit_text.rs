@@ -126,19 +126,26 @@ fn plain(x: f64) -> String {
 }
 
 fn header_lines(ctx: &ReportContext) -> Vec<String> {
-    let d: Vec<String> = ctx
-        .data
-        .diameters_mm()
-        .iter()
-        .map(|d| fmt_num(*d))
-        .collect();
+    // Identical spheres by their diameters; otherwise each pair as measured (a list of sizes
+    // would hide that 10 mm met 20 mm, or a wall).
+    let sizes = if ctx.data.identical_pairs() {
+        let d: Vec<String> = ctx
+            .data
+            .diameters_mm()
+            .iter()
+            .map(|d| fmt_num(*d))
+            .collect();
+        format!("d = {} mm", d.join(", "))
+    } else {
+        let pairs: Vec<String> = ctx.data.groups().iter().map(|g| g.label()).collect();
+        format!("pairs: {}", pairs.join(", "))
+    };
     let m = ctx.data.material;
     vec![
         format!(
-            "{}: {} points, d = {} mm; errors of e: {}",
+            "{}: {} points, {sizes}; errors of e: {}",
             ctx.path,
             ctx.data.len(),
-            d.join(", "),
             ctx.error_source
         ),
         format!(
