@@ -457,3 +457,31 @@ fn exact_and_master_agree_through_the_cli() {
     let (f, _) = get(&["--contact-end", "force"]);
     assert!((f / m - 1.0).abs() > 1e-3, "{f} {m}");
 }
+
+/// The figures show a parameter as the tables do: the wall example has one size, so the power
+/// law's A and a are determined only together ("not determined" in the table). The residual
+/// panel's caption printed where the minimiser stopped on that plateau (A = 0.176, a = 9.549 on
+/// the chain's data; A = 1.688e-3, a = -9.9 after a change of the search box) as if they were
+/// results.
+#[test]
+fn figures_do_not_print_an_undetermined_parameter_as_a_value() {
+    let dir = scratch("undetermined");
+    let r = run(&[
+        "fit",
+        "data/wall_example.csv",
+        "--material",
+        "nylon",
+        "--model",
+        "powerlaw",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    assert!(r.stdout.contains("not determined"), "{}", r.stdout);
+    let svg = std::fs::read_to_string(dir.join("residuals.svg")).unwrap();
+    assert!(
+        svg.contains("A not determined, a not determined, b = "),
+        "{svg}"
+    );
+    assert!(!svg.contains("A = ") && !svg.contains("a = "));
+}

@@ -8,7 +8,7 @@ pub use fig7::fig7_svg;
 pub use residuals::residuals_svg;
 
 use super::PlotFailure;
-use crate::fit::result::FitResult;
+use crate::fit::result::{FitResult, ParamStatus};
 use plotters::coord::CoordTranslate;
 use plotters::coord::Shift;
 use plotters::element::{Circle, Cross, EmptyElement, PathElement, Rectangle, TriangleMarker};
@@ -197,6 +197,9 @@ fn short_value(x: f64) -> String {
     }
 }
 
+/// The fit's parameters as the tables show them: a value, a 95% bound, or "not determined" (the
+/// minimiser's end on a plateau is arbitrary: printed as a value it read as a result; the curve
+/// drawn from it is the fitted one all the same).
 fn describe(f: &FitResult) -> String {
     let parts: Vec<String> = f
         .params
@@ -207,7 +210,16 @@ fn describe(f: &FitResult) -> String {
             } else {
                 format!(" {}", p.unit)
             };
-            format!("{} = {}{unit}", p.key, short_value(p.best_fit))
+            let shown = |rel: &str, x: Option<f64>| match x {
+                Some(x) => format!("{} {rel} {}{unit}", p.key, short_value(x)),
+                None => format!("{} not determined", p.key),
+            };
+            match p.status {
+                ParamStatus::Estimate | ParamStatus::IntervalLost => shown("=", Some(p.best_fit)),
+                ParamStatus::LowerBound => shown(">", p.ci95.0),
+                ParamStatus::UpperBound => shown("<", p.ci95.1),
+                ParamStatus::Unconstrained => shown("", None),
+            }
         })
         .collect();
     parts.join(", ")
