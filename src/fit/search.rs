@@ -216,30 +216,6 @@ pub fn global_minimum(obj: &Objective, options: &FitOptions) -> Result<SearchOut
     }
 }
 
-/// How far two computations of one chi2 of `n` non-negative terms in different orders may
-/// differ: each is within (n - 1) u of the terms' total, u the unit roundoff (Higham, "Accuracy
-/// and Stability of Numerical Algorithms", 2nd ed., 2002, §4.2), so 2 (n + 10) u |chi2|
-/// covers both with room for the few operations that form each term (2.2e-11 relative at
-/// 100 000 points, far below the search's tolerance of 1e-7).
-fn sums_rounding(n: usize, chi2: f64) -> f64 {
-    2.0 * (n as f64 + 10.0) * (f64::EPSILON / 2.0) * chi2.abs()
-}
-
-/// How far a grid node's chi2 and a polish's at the same parameters may differ: the sums'
-/// rounding ([`sums_rounding`]) and the model's, for the two evaluate e in different forms (the
-/// power law's node a product of its rows' exponentials, the polish one exponential of a sum:
-/// each argument's rounding, up to 300 u, is a relative error of e's distance from 1). Each e is
-/// within the model's stated accuracy d of the exact one ([`Objective::e_accuracy`]), so each
-/// residual differs by at most 2 d / sigma_i, and chi2 by at most
-/// 2 (2 d) sum w_i |r_i| + (2 d)^2 W <= 4 d sqrt(W chi2) + 4 d^2 W, W = sum w_i (Cauchy-Schwarz).
-/// Seed 2043 of the randomized test (the power law at a = -10, b = 10): 1.8e-12 apart, where the
-/// sums' rounding allowed 1.7e-13.
-fn evaluation_rounding(obj: &Objective, chi2: f64) -> f64 {
-    let w: f64 = obj.inv_sigma.iter().map(|s| s * s).sum();
-    let d = 2.0 * obj.e_accuracy;
-    sums_rounding(obj.ev.len(), chi2) + 2.0 * d * (w * chi2.abs()).sqrt() + w * d * d
-}
-
 /// Resolution of the branch and bound around the minima, in standard errors (the cost grows as
 /// 1/RESOLUTION): `min` and `product`, whose e_pm has a kink (min) or a jump of curvature at
 /// yield that can put shallow minima close together; the smooth power law; one-parameter
@@ -421,7 +397,7 @@ fn run<L: Landscape>(
     // (after one more polish from the node itself) by more than the rounding of the sums: a
     // node's chi2 and a polish's are summed in different orders, so a polish that converged on
     // the node itself can end an ulp above it (and was reported as not converged).
-    let reaches = |f: &Found, node_v: f64| f.chi2 <= node_v + evaluation_rounding(obj, node_v);
+    let reaches = |f: &Found, node_v: f64| f.chi2 <= node_v + obj.evaluation_rounding(node_v);
     let (_, _, node_v) = bnb.best_node().expect("checked above");
     if best_of(&polished).is_none_or(|f| !reaches(&f, node_v))
         && let Some(c) = bnb.best_candidate()
