@@ -135,9 +135,11 @@ def export(
     walton : path, WaltonResult or dict, optional
         mu_0 and beta_0 from ``restitution walton fit``; or give `mu0` (and `beta0`).
     d_mm : float or sequence, optional
-        The scene's sphere sizes, mm, one engine type each (default: the fit data's).
+        The scene's sphere sizes, mm, one engine type each (default: the fit data's spheres,
+        both of each pair, with a wall if the data hit one).
     wall : bool
-        Spheres also hit flat walls of the same material.
+        Spheres also hit flat walls of the same material (also when `d_mm` is not given and the
+        fit data hit a wall).
     v_range : (lo, hi), optional
         The scene's normal impact speeds, m/s (needed by every law but vm's).
     weight : {"log", "uniform"}

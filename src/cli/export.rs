@@ -13,7 +13,8 @@
 //! PARAMS.json is what `restitution fit --out` writes (material, contact end, the fitted models;
 //! the preferred one unless --model); WALTON.json what `restitution walton fit --out` writes
 //! (mu_0, beta_0). `--d-mm` sets the scene's sphere sizes (one engine type each; default: the fit
-//! data's), `--wall` adds sphere-wall contacts. Engines:
+//! data's spheres, both of each pair, with a wall if the data hit one), `--wall` adds sphere-wall
+//! contacts. Engines:
 //! - `lammps`: DIR/in.restitution (`pair_style granular` and every `pair_coeff`), DIR/collide.in;
 //!   exact for `vm`, otherwise the closest viscoelastic law or constant e over --v-range
 //!   (`--law`, default the closer one);
@@ -78,7 +79,8 @@ pub struct Args {
     walton: Option<PathBuf>,
     #[command(flatten)]
     material: MaterialArgs,
-    /// Sphere diameters of the scene, mm (one engine atom type each)
+    /// Sphere diameters of the scene, mm (one engine atom type each; default: both spheres of
+    /// the fit data's pairs, and a wall if they hit one)
     #[arg(long = "d-mm", value_name = "D", value_delimiter = ',', num_args = 1..)]
     d_mm: Vec<f64>,
     /// Spheres also hit flat walls of the same material
