@@ -438,10 +438,19 @@ impl BenchReport {
                 "| method | setting | eta rel. error | fit ms | model error | meets | note |\n|---|---|---|---|---|---|---|"
             );
             for (i, r) in f.rows.iter().enumerate() {
+                // A "no" says why: the fit failed, or it was not converged (its search could
+                // not certify the minimum within the model's stated accuracy), or the model
+                // error is above the rule's threshold.
                 let note = if f.default_row == Some(i) {
                     "**default: cheapest that meets the rule**".to_string()
+                } else if let Some(why) = &r.failure {
+                    why.clone()
+                } else if !r.converged {
+                    "fit not converged (the minimum not certified global)".to_string()
+                } else if !r.meets {
+                    "model error above the threshold".to_string()
                 } else {
-                    r.failure.clone().unwrap_or_default()
+                    String::new()
                 };
                 let _ = writeln!(
                     s,
