@@ -50,7 +50,9 @@ use super::kinks::{axis_stderr, kink_starts, polish_profiles};
 use super::landscape::{PowerLaw, Separable};
 use super::models::{Evaluator, ModelKind};
 use super::objective::Objective;
-use super::polish::{Found, polish_brent, polish_lm, polish_newton, polish_valleys};
+use super::polish::{
+    Found, polish_at_bounds, polish_brent, polish_lm, polish_newton, polish_valleys,
+};
 use super::powerlaw::polish_powerlaw;
 use super::result::{GlobalSearch, show};
 use super::sums;
@@ -389,6 +391,7 @@ fn run<L: Landscape>(
                 }
             }
             let v = polish_valleys(obj, v, &may_beat)?;
+            let v = polish_at_bounds(obj, v)?;
             polished.push(v);
         }
     }
