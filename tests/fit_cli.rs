@@ -45,6 +45,15 @@ fn write(dir: &Path, name: &str, text: &str) -> String {
     p.to_string_lossy().into()
 }
 
+/// The files `fit --out` writes.
+const REPORT_FILES: [&str; 5] = [
+    "params.md",
+    "params.csv",
+    "params.json",
+    "fig7.svg",
+    "residuals.svg",
+];
+
 fn keys(v: &serde_json::Value) -> Vec<String> {
     v.as_object().expect("an object").keys().cloned().collect()
 }
@@ -255,13 +264,7 @@ fn out_writes_all_files_and_they_agree_with_stdout() {
         "json",
     ]);
     assert!(r.ok, "{}", r.stderr);
-    for f in [
-        "params.md",
-        "params.csv",
-        "params.json",
-        "fig7.svg",
-        "residuals.svg",
-    ] {
+    for f in REPORT_FILES {
         let text = std::fs::read_to_string(out.join(f)).unwrap();
         assert!(!text.is_empty(), "{f}");
         if f.ends_with(".svg") {
@@ -504,13 +507,7 @@ fn the_committed_fit_report_is_current() {
     ]);
     assert!(r.ok, "{}", r.stderr);
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/fit");
-    for f in [
-        "params.md",
-        "params.csv",
-        "params.json",
-        "fig7.svg",
-        "residuals.svg",
-    ] {
+    for f in REPORT_FILES {
         let now = std::fs::read(out.join(f)).unwrap();
         let committed = std::fs::read(shipped.join(f)).unwrap();
         assert!(
