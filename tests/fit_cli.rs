@@ -517,3 +517,41 @@ fn the_committed_fit_report_is_current() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Many sizes: the header names eight and counts the rest, and the figures draw the points as
+/// one group with no curve per size (100 000 rows of distinct sizes made a header of 3 MB, a
+/// legend of 100 000 rows and 19 s of `fit --out`).
+#[test]
+fn many_sizes_are_counted_not_listed() {
+    let dir = scratch("sizes");
+    let mut csv = String::from("d_mm,d2_mm,v_n_m_s,e,e_err\n");
+    for k in 0..20 {
+        let v = 0.5 * 1.2f64.powi(k);
+        csv += &format!("{},{},{v},{},0.02\n", 5 + k, 6 + k, 0.95 - 0.01 * k as f64);
+    }
+    let data = write(&dir, "sizes.csv", &csv);
+    let out = dir.join("out");
+    let r = run(&[
+        "fit",
+        &data,
+        "--material",
+        "nylon",
+        "--model",
+        "vm",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let head = r.stdout.lines().next().unwrap();
+    assert!(
+        head.contains("pairs: 5 mm on 6 mm, ")
+            && head.contains(", 12 mm on 13 mm, ... (20 in all);")
+            && !head.contains("13 mm on 14 mm"),
+        "{head}"
+    );
+    let fig7 = std::fs::read_to_string(out.join("fig7.svg")).unwrap();
+    assert!(fig7.contains("data, 20 geometries") && fig7.contains("VM, curves left out: "));
+    let res = std::fs::read_to_string(out.join("residuals.svg")).unwrap();
+    assert!(res.contains("20 geometries") && !res.contains("5 mm on 6 mm"));
+    let _ = std::fs::remove_dir_all(&dir);
+}

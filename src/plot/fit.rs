@@ -8,11 +8,41 @@ pub use fig7::fig7_svg;
 pub use residuals::residuals_svg;
 
 use super::PlotFailure;
+use crate::fit::dataset::{FitData, Group};
 use crate::fit::result::{FitResult, ParamStatus};
 use plotters::coord::CoordTranslate;
 use plotters::coord::Shift;
 use plotters::element::{Circle, Cross, EmptyElement, PathElement, Rectangle, TriangleMarker};
 use plotters::prelude::*;
+
+/// Pair geometries drawn each in its own colour at most; beyond, the points are one group.
+const MAX_GROUPS_DRAWN: usize = 8;
+
+/// The data's pair geometries as the figures draw them, with their labels, and whether they
+/// were merged: each on its own, or, beyond MAX_GROUPS_DRAWN, every point in one group labelled
+/// with their count ("100000 geometries"; 100 000 rows of distinct sizes made a legend of 100 000 rows, a curve per
+/// size, and 19 s of `fit --out`).
+fn drawn_groups(data: &FitData) -> (Vec<(Group, String)>, bool) {
+    let groups = data.groups();
+    if groups.len() <= MAX_GROUPS_DRAWN {
+        return (
+            groups
+                .into_iter()
+                .map(|g| {
+                    let label = g.label();
+                    (g, label)
+                })
+                .collect(),
+            false,
+        );
+    }
+    let all = Group {
+        d_mm: groups[0].d_mm,
+        d2_mm: groups[0].d2_mm,
+        indices: (0..data.len()).collect(),
+    };
+    (vec![(all, format!("{} geometries", groups.len()))], true)
+}
 
 fn colour(g: usize) -> RGBColor {
     super::colour(g)

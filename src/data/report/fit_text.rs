@@ -125,9 +125,24 @@ fn plain(x: f64) -> String {
     }
 }
 
+/// Sizes or pairs the header names before it gives only their count.
+const MAX_SIZES_LISTED: usize = 8;
+
 fn header_lines(ctx: &ReportContext) -> Vec<String> {
     // Identical spheres by their diameters; otherwise each pair as measured (a list of sizes
-    // would hide that 10 mm met 20 mm, or a wall).
+    // would hide that 10 mm met 20 mm, or a wall). A line, not a page: 100 000 rows of distinct
+    // sizes listed them all.
+    let listed = |items: Vec<String>| {
+        if items.len() <= MAX_SIZES_LISTED {
+            items.join(", ")
+        } else {
+            format!(
+                "{}, ... ({} in all)",
+                items[..MAX_SIZES_LISTED].join(", "),
+                items.len()
+            )
+        }
+    };
     let sizes = if ctx.data.identical_pairs() {
         let d: Vec<String> = ctx
             .data
@@ -135,10 +150,10 @@ fn header_lines(ctx: &ReportContext) -> Vec<String> {
             .iter()
             .map(|d| fmt_num(*d))
             .collect();
-        format!("d = {} mm", d.join(", "))
+        format!("d = {} mm", listed(d))
     } else {
         let pairs: Vec<String> = ctx.data.groups().iter().map(|g| g.label()).collect();
-        format!("pairs: {}", pairs.join(", "))
+        format!("pairs: {}", listed(pairs))
     };
     let m = ctx.data.material;
     vec![

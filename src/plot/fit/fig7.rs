@@ -1,8 +1,8 @@
 //! `fig7.svg`: the paper's Fig. 7 with the fitted models.
 
 use super::{
-    Sample, colour, describe, draw_legend, draw_markers, log_points, log_ticks, short_value,
-    svg_err,
+    Sample, colour, describe, draw_legend, draw_markers, drawn_groups, log_points, log_ticks,
+    short_value, svg_err,
 };
 use crate::fit::dataset::{FitData, Group};
 use crate::fit::engine::FitSet;
@@ -55,7 +55,8 @@ fn draw_fig7(
     method: &VmMethod,
     title: &str,
 ) -> Result<String, PlotFailure> {
-    let groups = data.groups();
+    let (drawn, merged) = drawn_groups(data);
+    let groups: Vec<&Group> = drawn.iter().map(|(g, _)| g).collect();
     let (mut vlo, mut vhi) = (f64::INFINITY, 0.0f64);
     let (mut elo, mut ehi) = (f64::INFINITY, 0.0f64);
     for (i, o) in data.obs.iter().enumerate() {
@@ -86,16 +87,17 @@ fn draw_fig7(
             ""
         }
     };
-    let data_key: Vec<(Sample, String)> = groups
+    let data_key: Vec<(Sample, String)> = drawn
         .iter()
         .enumerate()
-        .map(|(gi, g)| {
-            (
-                Sample::Marker(gi, colour(gi)),
-                format!("data, {}", g.label()),
-            )
-        })
+        .map(|(gi, (_, label))| (Sample::Marker(gi, colour(gi)), format!("data, {label}")))
         .collect();
+    // A curve per size only where the sizes are drawn apart.
+    let per_size = if merged {
+        "curves left out"
+    } else {
+        "one per size"
+    };
     let mut legend: Vec<(Sample, String)> = Vec::new();
     let combined = preferred
         .filter(|k| !matches!(k, ModelKind::Vm | ModelKind::Pm))
@@ -103,20 +105,25 @@ fn draw_fig7(
     if let Some(f) = find(ModelKind::Vm) {
         legend.push((
             Sample::Line(RGBColor(90, 90, 90), 2),
-            format!("VM{}, one per size: {}", tag(ModelKind::Vm), describe(f)),
+            format!("VM{}, {per_size}: {}", tag(ModelKind::Vm), describe(f)),
         ));
     }
     if let Some(f) = find(ModelKind::Pm) {
         legend.push((
             Sample::Dashed(BLACK, 2),
-            format!("PM{}: {}", tag(ModelKind::Pm), describe(f)),
+            format!(
+                "PM{}{}: {}",
+                tag(ModelKind::Pm),
+                if merged { ", curves left out" } else { "" },
+                describe(f)
+            ),
         ));
     }
     if let Some(f) = combined {
         legend.push((
             Sample::Dashed(RGBColor(90, 90, 90), 4),
             format!(
-                "{} (preferred), one per size: {}",
+                "{} (preferred), {per_size}: {}",
                 f.model.name(),
                 describe(f)
             ),
@@ -158,7 +165,7 @@ fn draw_fig7(
             .map_err(svg_err)?;
 
         // Model curves first, so the data stay on top.
-        if let Some(f) = find(ModelKind::Vm) {
+        if let Some(f) = find(ModelKind::Vm).filter(|_| !merged) {
             for (gi, g) in groups.iter().enumerate() {
                 let pts = curve(f, g, data, &vs, rule, method, y_range);
                 chart
@@ -166,7 +173,7 @@ fn draw_fig7(
                     .map_err(svg_err)?;
             }
         }
-        if let Some(f) = find(ModelKind::Pm) {
+        if let Some(f) = find(ModelKind::Pm).filter(|_| !merged) {
             let mut seen: Vec<f64> = Vec::new();
             for g in &groups {
                 let vy = data.contacts[g.indices[0]].yield_velocity_m_s(f.best_fit_values()[0]);
@@ -180,7 +187,7 @@ fn draw_fig7(
                     .map_err(svg_err)?;
             }
         }
-        if let Some(f) = combined {
+        if let Some(f) = combined.filter(|_| !merged) {
             for (gi, g) in groups.iter().enumerate() {
                 let pts = curve(f, g, data, &vs, rule, method, y_range);
                 chart

@@ -1,6 +1,9 @@
 //! `residuals.svg`: the normalised residuals of every fitted model.
 
-use super::{Sample, colour, describe, draw_legend, draw_markers, log_ticks, short_value, svg_err};
+use super::{
+    Sample, colour, describe, draw_legend, draw_markers, drawn_groups, log_ticks, short_value,
+    svg_err,
+};
 use crate::fit::dataset::FitData;
 use crate::fit::engine::FitSet;
 use crate::plot::{PlotError, PlotFailure, log_axis};
@@ -14,7 +17,7 @@ pub fn residuals_svg(data: &FitData, set: &FitSet, title: &str) -> Result<String
 }
 
 fn draw_residuals(data: &FitData, set: &FitSet, title: &str) -> Result<String, PlotFailure> {
-    let groups = data.groups();
+    let (drawn, _) = drawn_groups(data);
     let n = set.fits.len().max(1);
     let (mut vlo, mut vhi) = (f64::INFINITY, 0.0f64);
     for o in &data.obs {
@@ -32,13 +35,13 @@ fn draw_residuals(data: &FitData, set: &FitSet, title: &str) -> Result<String, P
         root.fill(&WHITE).map_err(svg_err)?;
         let root = root.titled(title, ("sans-serif", 22)).map_err(svg_err)?;
         let (key, body) = root.split_vertically(34);
-        let columns: Vec<(i32, Vec<(Sample, String)>)> = groups
+        let columns: Vec<(i32, Vec<(Sample, String)>)> = drawn
             .iter()
             .enumerate()
-            .map(|(gi, g)| {
+            .map(|(gi, (_, label))| {
                 (
                     90 + 220 * gi as i32,
-                    vec![(Sample::Marker(gi, colour(gi)), g.label())],
+                    vec![(Sample::Marker(gi, colour(gi)), label.clone())],
                 )
             })
             .collect();
@@ -109,7 +112,7 @@ fn draw_residuals(data: &FitData, set: &FitSet, title: &str) -> Result<String, P
                         .map_err(svg_err)?;
                 }
             }
-            for (gi, g) in groups.iter().enumerate() {
+            for (gi, (g, _)) in drawn.iter().enumerate() {
                 let c = colour(gi);
                 let pts: Vec<(f64, f64)> = g
                     .indices
