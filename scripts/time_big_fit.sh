@@ -21,7 +21,8 @@
 # Ninth session, on a faster host (2 Intel Xeon cores): 2.48 s and 1.31 s at its start; with
 # first-order passes where the sample predicts them, the cell pass's sums in four lanes, the
 # power law's nodes in two passes and the starting cells bounded by blocks 2.28-2.29 s and
-# 1.21 s (per model 0.19-0.91 s).
+# 1.21 s (per model 0.19-0.91 s). Thirteenth session: sizes.csv, 100 000 pairs of sizes each
+# with its own kink of `min` (the polishes across kinks and the finishing rounds had taken 46 s).
 #
 # Usage: bash scripts/time_big_fit.sh [BINARY]   (default target/release/restitution)
 set -euo pipefail
@@ -31,8 +32,11 @@ BIN=${1:-target/release/restitution}
 dir=$(mktemp -d)
 trap 'rm -rf "$dir"' EXIT
 python3 scripts/big_fit_data.py "$dir"
-for data in repeated distinct; do
-    for m in vm pm min product powerlaw all; do
+for data in repeated distinct sizes; do
+    models="vm pm min product powerlaw all"
+    # sizes.csv: the case of `min` with a kink per point (thirteenth session).
+    [ "$data" = sizes ] && models="min all"
+    for m in $models; do
         /usr/bin/time -f "$data $m: %U s user + %S s system, %e s wall" \
             "$BIN" fit "$dir/$data.csv" --material nylon --model "$m" > /dev/null 2> "$dir/err" || true
         tail -1 "$dir/err"

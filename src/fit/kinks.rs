@@ -46,8 +46,11 @@ pub fn axis_stderr(obj: &Objective, theta: &[f64]) -> Result<[f64; 2]> {
 /// Starts across the kinks of `min` near theta: for each point whose two branches meet within
 /// [`KINK_REACH`] standard errors and whose residual is positive there (chi2 then has a ridge
 /// along the kink, so a second minimum may sit just across it), theta mirrored across the kink
-/// (linearised). Convex kinks (negative residual) cannot hide a second minimum.
-pub fn kink_starts(obj: &Objective, theta: &[f64], sd: [f64; 2]) -> Result<(Vec<Vec<f64>>, bool)> {
+/// (linearised), with the ridge's strength: the jump of chi2's slope across it, per standard
+/// error (2 |r_i| |grad(e_vm - e_pm)| / sigma_i^2, the gradient in standard errors). Convex kinks
+/// (negative residual) cannot hide a second minimum. Also returned: whether theta is within 1%
+/// of a standard error of some point's kink.
+pub fn kink_starts(obj: &Objective, theta: &[f64], sd: [f64; 2]) -> Result<(Vec<KinkStart>, bool)> {
     let ev = obj.ev;
     let (t0, t1) = (theta[0], theta[1]);
     // Central differences in the log parameters, step matched to the model (see fd_step).
@@ -75,10 +78,22 @@ pub fn kink_starts(obj: &Objective, theta: &[f64], sd: [f64; 2]) -> Result<(Vec<
             (t1 + k * gy).clamp(obj.lower[1], obj.upper[1]),
         ];
         if start.iter().all(|x| x.is_finite()) {
-            out.push(start);
+            let w = obj.inv_sigma[i];
+            out.push(KinkStart {
+                theta: start,
+                ridge: 2.0 * (f.min(g) - ev.data.obs[i].e).abs() * w * w * reach,
+            });
         }
     }
     Ok((out, on_kink))
+}
+
+/// A start of [`kink_starts`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct KinkStart {
+    pub theta: Vec<f64>,
+    /// The jump of chi2's slope across the kink, per standard error.
+    pub ridge: f64,
 }
 
 /// The profile of a two-parameter model along axis `outer` at `u`: the other parameter
@@ -113,7 +128,7 @@ fn profile_point(
             },
             lo,
             hi,
-            1e-13,
+            width * 1e-5,
         )?;
         if m.fx < v {
             (v, at) = (m.fx, m.x);
@@ -124,8 +139,10 @@ fn profile_point(
 
 /// Brent's method on the profile along each axis of a two-parameter model in turn (see
 /// `profile_point`), over +-[`VALLEY_REACH`] standard errors, then Levenberg-Marquardt; repeated
-/// while it gains.
-pub fn polish_profiles(obj: &Objective, start: Found) -> Result<Found> {
+/// while a round gains at least `min_gain` (the search passes its tolerance tau: a round that
+/// gained less has reached the minimum within the accuracy the search states, and each costs
+/// about a hundred profile points).
+pub fn polish_profiles(obj: &Objective, start: Found, min_gain: f64) -> Result<Found> {
     let mut best = start;
     for _ in 0..VALLEY_ROUNDS {
         let before = best.chi2;
@@ -175,7 +192,7 @@ pub fn polish_profiles(obj: &Objective, start: Found) -> Result<Found> {
                 (a, b) = (lo, hi);
             }
             centre.set(base[inner]);
-            let m = scalar::brent_minimize(p, lo, hi, 1e-12)?;
+            let m = scalar::brent_minimize(p, lo, hi, 1e-6 * sd[outer])?;
             if m.fx < fu {
                 (u, fu) = (m.x, m.fx);
             }
@@ -198,7 +215,7 @@ pub fn polish_profiles(obj: &Objective, start: Found) -> Result<Found> {
         if again.chi2 <= best.chi2 {
             best = again;
         }
-        if !(best.chi2 < before - 1e-12 * before.abs()) {
+        if !(best.chi2 < before - min_gain.max(1e-12 * before.abs())) {
             break;
         }
     }
@@ -247,7 +264,7 @@ mod tests {
         let start = [truth[0] + 0.3, truth[1] - 0.05];
         let f = polish_lm(&obj, &start).unwrap();
         let f = polish_valleys(&obj, f, &|_| true).unwrap();
-        let f = polish_profiles(&obj, f).unwrap();
+        let f = polish_profiles(&obj, f, 0.0).unwrap();
         let close = f
             .theta
             .iter()

@@ -213,6 +213,44 @@ pub fn jacobian_fd(
     Ok(jac)
 }
 
+/// The decrease of chi2 that one undamped Gauss-Newton step from theta predicts:
+/// g^T (J^T J)^+ g with g = J^T f (the squared length of f's projection on J's columns).
+///
+/// Zero at a stationary point of a smooth chi2, and the exact distance to the minimum for a
+/// model linear in theta. Where Levenberg-Marquardt ends with the damping driven up rather than
+/// at a stationary point (on a kink of `min`, whose exact Jacobian is the active branch's), it
+/// stays as large as the gain one branch still promises: the search's test of whether a
+/// minimum needs a costlier polish. Columns are scaled to unit norm, and eigenvalues of J^T J
+/// below 1e-12 of the largest dropped, as in [`covariance`]; a zero column (a parameter on a
+/// plateau) promises nothing.
+pub fn gauss_newton_decrease(p: &impl Residuals, theta: &[f64]) -> Result<f64> {
+    let mut f = vec![0.0; p.n_residuals()];
+    residuals_checked(p, theta, &mut f)?;
+    let jac = jacobian(p, theta, &vec![true; theta.len()], &f)?;
+    if jac.iter().any(|x| !x.is_finite()) {
+        return Ok(f64::INFINITY);
+    }
+    let (g, norms, _, jtj) = normal_parts(&jac, &f);
+    let live: Vec<usize> = (0..norms.len()).filter(|&j| norms[j] > 0.0).collect();
+    let m = live.len();
+    if m == 0 {
+        return Ok(0.0);
+    }
+    let a = DMatrix::from_fn(m, m, |r, c| {
+        jtj[(live[r], live[c])] / (norms[live[r]] * norms[live[c]])
+    });
+    let gs = DVector::from_fn(m, |r, _| g[live[r]] / norms[live[r]]);
+    let eig = a.symmetric_eigen();
+    let emax = eig.eigenvalues.iter().cloned().fold(0.0, f64::max);
+    let mut out = 0.0;
+    for (q, &lam) in eig.eigenvalues.iter().enumerate() {
+        if lam > 1e-12 * emax {
+            out += eig.eigenvectors.column(q).dot(&gs).powi(2) / lam;
+        }
+    }
+    Ok(out)
+}
+
 /// Settings of [`levenberg_marquardt`]; the defaults are MINPACK's tolerances tightened to
 /// what a model accurate to ~1e-15 supports.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -565,6 +603,73 @@ mod tests {
     /// Straight line y = c0 + c1 x with sigma = 1: the least-squares covariance is (X^T X)^-1
     /// in closed form: var(c1) = n / D, var(c0) = sum x^2 / D, cov = -sum x / D,
     /// D = n sum x^2 - (sum x)^2.
+    /// y = c0 + c1 x + c2 * 0 (c2 has no effect: a plateau) with noise, sigma = 1.
+    struct Line {
+        x: Vec<f64>,
+        y: Vec<f64>,
+        lo: Vec<f64>,
+        hi: Vec<f64>,
+    }
+
+    impl Residuals for Line {
+        fn n_params(&self) -> usize {
+            3
+        }
+        fn n_residuals(&self) -> usize {
+            self.x.len()
+        }
+        fn residuals(&self, t: &[f64], out: &mut [f64]) -> Result<()> {
+            for ((o, x), y) in out.iter_mut().zip(&self.x).zip(&self.y) {
+                *o = t[0] + t[1] * x - y;
+            }
+            Ok(())
+        }
+        fn lower(&self) -> &[f64] {
+            &self.lo
+        }
+        fn upper(&self) -> &[f64] {
+            &self.hi
+        }
+        fn fd_step(&self) -> f64 {
+            1e-3
+        }
+    }
+
+    #[test]
+    fn gauss_newton_decrease_of_a_line_is_the_distance_to_its_minimum() {
+        // For a model linear in theta chi2 is quadratic, so one Gauss-Newton step lands on the
+        // minimum: the predicted decrease is chi2(theta) - chi2_min, chi2_min from the closed
+        // form of ordinary least squares. Central differences of a linear model are exact to
+        // rounding: 1e-9 relative covers the sums. The parameter without effect adds nothing.
+        let x: Vec<f64> = (0..30).map(|i| i as f64 * 0.1).collect();
+        let y: Vec<f64> = x
+            .iter()
+            .enumerate()
+            .map(|(i, &x)| 1.5 - 0.8 * x + 0.05 * (i as f64 * 1.7).sin())
+            .collect();
+        let n = x.len() as f64;
+        let (sx, sy) = (x.iter().sum::<f64>(), y.iter().sum::<f64>());
+        let sxx: f64 = x.iter().map(|x| x * x).sum();
+        let sxy: f64 = x.iter().zip(&y).map(|(x, y)| x * y).sum();
+        let c1 = (n * sxy - sx * sy) / (n * sxx - sx * sx);
+        let c0 = (sy - c1 * sx) / n;
+        let p = Line {
+            x,
+            y,
+            lo: vec![-10.0; 3],
+            hi: vec![10.0; 3],
+        };
+        let at_min = chi2(&p, &[c0, c1, 0.0]).unwrap();
+        for t in [[0.0, 0.0, 0.0], [c0 + 0.3, c1 - 0.2, 5.0], [c0, c1, -2.0]] {
+            let want = chi2(&p, &t).unwrap() - at_min;
+            let got = gauss_newton_decrease(&p, &t).unwrap();
+            assert!(
+                (got - want).abs() <= 1e-9 * want.max(at_min),
+                "{t:?}: {got} {want}"
+            );
+        }
+    }
+
     #[test]
     fn lm_failures_are_values_not_hangs() {
         let x: Vec<f64> = (0..20).map(|i| i as f64 * 0.25).collect();

@@ -25,11 +25,16 @@
 //! **Polishes** ([`super::polish`], [`super::kinks`], [`super::powerlaw`]): from every grid-local
 //! minimum (a node not above its neighbours at its cell's scale) in a cell whose bound could beat
 //! U: Brent's method for one parameter, Levenberg-Marquardt for two, Levenberg-Marquardt over the
-//! power law's exponents with A profiled out. For `min`, starts mirrored across nearby kinks. The
-//! minima within 1e-5 relative of the best are finished: Brent on the profiles where
-//! Levenberg-Marquardt stopped on a kink of `min`, damped Newton where it ran out of iterations,
-//! line searches along the covariance's axes (whose scans skip the points where the bounds
-//! already exclude chi2 below U - tau: [`super::bnb::Bnb::may_hold_below`]). The reported
+//! power law's exponents with A profiled out. For `min`, starts mirrored across nearby kinks
+//! (one per cell of the resolution, none where the bounds already exclude chi2 below U - tau:
+//! [`super::bnb::Bnb::may_hold_below`]). The minima within 1e-5 relative of the best are
+//! finished, once per cell of the resolution: rounds of Brent on the profiles where
+//! Levenberg-Marquardt stopped on a kink of `min` short of the minimum by more than tau as far
+//! as its Gauss-Newton step tells ([`super::lsq::gauss_newton_decrease`]), while a round gains
+//! more than tau; damped Newton where it ran out of iterations; line searches along the
+//! covariance's axes (whose scans skip the points where the bounds already exclude chi2 below
+//! U - tau). On many points of many sizes some point is always near its kink, and the kinks
+//! are many and weak: these rules keep the work of such a fit that of any other. The reported
 //! minimum is the lowest polished point, the best grid node only where every polish ended
 //! above it by more than the rounding of the sums (a node and a polish sum chi2 in different
 //! orders). A point below the certified bound would contradict the bounds: a warning, never
@@ -46,7 +51,7 @@
 
 use super::FitOptions;
 use super::bnb::{Bnb, Candidate, Landscape, Limits, starting_rows};
-use super::kinks::{axis_stderr, kink_starts, polish_profiles};
+use super::kinks::{KinkStart, axis_stderr, kink_starts, polish_profiles};
 use super::landscape::{PowerLaw, Separable};
 use super::models::{Evaluator, ModelKind};
 use super::objective::Objective;
@@ -55,9 +60,10 @@ use super::polish::{
 };
 use super::powerlaw::polish_powerlaw;
 use super::result::{GlobalSearch, show};
-use super::sums;
+use super::{lsq, sums};
 use crate::error::{Error, Num, Result};
 use crate::models::viscoelastic::VmMethod;
+use std::collections::HashMap;
 
 /// tau = TAU_REL U + TAU_ABS s (see the module doc).
 pub const TAU_REL: f64 = 1e-7;
@@ -300,14 +306,18 @@ fn run<L: Landscape>(
     for c in bnb.initial_minima(upper, tau_of(upper)) {
         try_polish(&bnb, &c, &mut polished, &mut upper)?;
     }
+    let resolution = match obj.kind {
+        ModelKind::Vm | ModelKind::Pm => RESOLUTION_1D,
+        ModelKind::Min | ModelKind::Product => RESOLUTION_2D,
+        ModelKind::PowerLaw => RESOLUTION_SMOOTH,
+    };
+    // The widths of the finest cells (none without a polished point: nothing is refined).
+    let mut fine_width = None;
     if let Some(b) = best_of(&polished) {
         let sd = axis_stderr(obj, &b.theta)?;
-        let k = match obj.kind {
-            ModelKind::Vm | ModelKind::Pm => RESOLUTION_1D,
-            ModelKind::Min | ModelKind::Product => RESOLUTION_2D,
-            ModelKind::PowerLaw => RESOLUTION_SMOOTH,
-        };
-        bnb.set_resolution([k * sd[0], k * sd[1]]);
+        let w = [resolution * sd[0], resolution * sd[1]];
+        bnb.set_resolution(w);
+        fine_width = Some(w);
     }
     bnb.refine(upper, &tau_of);
     if let Some((_, _, v)) = bnb.best_node()
@@ -328,7 +338,31 @@ fn run<L: Landscape>(
             }
             looked.push(b.theta.clone());
             let sd = axis_stderr(obj, &b.theta)?;
-            for start in kink_starts(obj, &b.theta, sd)?.0 {
+            // On many points of many sizes there are hundreds of starts. One where the bounds
+            // already exclude chi2 below U - tau is not where a lower minimum sits (a start is
+            // a guess at one); of those a cell of the search's resolution (around the minimum)
+            // holds, the one across the highest ridge: the resolution is where the bounds hand
+            // over to the local polishes, one per cell.
+            let u = upper.min(lowest_of(&polished));
+            let target = u - tau_of(u);
+            let mut cells: HashMap<[i64; 2], KinkStart> = HashMap::new();
+            for s in kink_starts(obj, &b.theta, sd)?.0 {
+                if !bnb.may_hold_below(axes_of(&s.theta), target) {
+                    continue;
+                }
+                let key = [0, 1]
+                    .map(|k| ((s.theta[k] - b.theta[k]) / (resolution * sd[k])).round() as i64);
+                match cells.get(&key) {
+                    Some(kept) if kept.ridge >= s.ridge => {}
+                    _ => {
+                        cells.insert(key, s);
+                    }
+                }
+            }
+            let mut kept: Vec<([i64; 2], KinkStart)> = cells.into_iter().collect();
+            kept.sort_by_key(|(key, _)| *key);
+            for (_, start) in kept {
+                let start = start.theta;
                 if n_polish >= MAX_POLISH {
                     skipped += 1;
                     continue;
@@ -368,30 +402,63 @@ fn run<L: Landscape>(
         let u = upper.min(best);
         let target = u - tau_of(u);
         let may_beat = |th: &[f64]| bnb.may_hold_below(axes_of(th), target);
+        let mut finished: Vec<Found> = Vec::new();
         for b in close.into_iter().take(MAX_FINISH) {
+            // A minimum within a finest cell's width of one already finished and not below it
+            // is the same minimum at the resolution the bounds stop at, reached again, and
+            // within reach of that one's finishing (its scans span +-VALLEY_REACH standard
+            // errors).
+            let at = axes_of(&b.theta);
+            let covered = fine_width.is_some_and(|w| {
+                finished.iter().any(|f| {
+                    f.chi2 <= b.chi2
+                        && (0..2).all(|k| {
+                            let (x, y) = (at[k], axes_of(&f.theta)[k]);
+                            x == y || (x - y).abs() <= w[k]
+                        })
+                })
+            });
+            if covered {
+                continue;
+            }
             n_polish += 1;
             // Levenberg-Marquardt that ran out of iterations (creeping along a narrow curved
             // valley) or stopped on a kink of `min` hands over to Brent on the profiles.
             let mut v = b;
             for _ in 0..3 {
+                // On a kink of `min` only where Levenberg-Marquardt stopped short of the
+                // minimum by more than tau as far as its Gauss-Newton step can tell: at a V-shaped
+                // kink chi2 is the larger of its two branches, so no lower than the minimum of
+                // the active branch's quadratic model. Many points of many sizes always have
+                // some point near its kink, and kinks too weak to matter.
                 let stuck = !v.converged
                     || (obj.kind == ModelKind::Min
-                        && kink_starts(obj, &v.theta, axis_stderr(obj, &v.theta)?)?.1);
+                        && kink_starts(obj, &v.theta, axis_stderr(obj, &v.theta)?)?.1
+                        && lsq::gauss_newton_decrease(obj, &v.theta)? > tau_of(v.chi2));
                 if obj.kind == ModelKind::PowerLaw || !stuck {
                     break;
                 }
                 let before = v.chi2;
                 v = if obj.kind == ModelKind::Min {
-                    polish_profiles(obj, v)?
+                    polish_profiles(obj, v, tau_of(before))?
                 } else {
                     polish_newton(obj, v)?
                 };
-                if !(v.chi2 < before) {
+                // Another round of profiles for a gain below tau would not move the answer
+                // beyond the accuracy the search states (Newton goes on while it gains: it
+                // also ends Levenberg-Marquardt's unconverged runs).
+                let min_gain = if obj.kind == ModelKind::Min {
+                    tau_of(before)
+                } else {
+                    0.0
+                };
+                if !(v.chi2 < before - min_gain) {
                     break;
                 }
             }
             let v = polish_valleys(obj, v, &may_beat)?;
             let v = polish_at_bounds(obj, v)?;
+            finished.push(v.clone());
             polished.push(v);
         }
     }
