@@ -222,7 +222,7 @@ pub fn jacobian_fd(
 /// stays as large as the gain one branch still promises: the search's test of whether a
 /// minimum needs a costlier polish. Columns are scaled to unit norm, and eigenvalues of J^T J
 /// below 1e-12 of the largest dropped, as in [`covariance`]; a zero column (a parameter on a
-/// plateau) promises nothing.
+/// plateau) promises nothing. +inf where the Jacobian or the sums are not finite.
 pub fn gauss_newton_decrease(p: &impl Residuals, theta: &[f64]) -> Result<f64> {
     let mut f = vec![0.0; p.n_residuals()];
     residuals_checked(p, theta, &mut f)?;
@@ -248,7 +248,9 @@ pub fn gauss_newton_decrease(p: &impl Residuals, theta: &[f64]) -> Result<f64> {
             out += eig.eigenvectors.column(q).dot(&gs).powi(2) / lam;
         }
     }
-    Ok(out)
+    // Residuals whose sums overflow promise nothing a caller can compare: +inf, as for a
+    // Jacobian that is not finite (a caller then takes the costlier path).
+    Ok(if out.is_nan() { f64::INFINITY } else { out })
 }
 
 /// Settings of [`levenberg_marquardt`]; the defaults are MINPACK's tolerances tightened to
@@ -668,6 +670,12 @@ mod tests {
                 "{t:?}: {got} {want}"
             );
         }
+        // Residuals that overflow (a difference of -inf and -inf in the Jacobian): +inf, never
+        // NaN (which compares as below every threshold).
+        let mut q = p;
+        q.y[0] = f64::MAX;
+        let got = gauss_newton_decrease(&q, &[-f64::MAX, 0.0, 0.0]).unwrap();
+        assert_eq!(got, f64::INFINITY);
     }
 
     #[test]
