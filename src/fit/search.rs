@@ -28,17 +28,17 @@
 //! power law's exponents with A profiled out. For `min`, starts mirrored across nearby kinks
 //! (one per cell of the resolution, none where the bounds already exclude chi2 below U - tau:
 //! [`super::bnb::Bnb::may_hold_below`]). The minima within 1e-5 relative of the best are
-//! finished, once per cell of the resolution: rounds of Brent on the profiles where
-//! Levenberg-Marquardt stopped on a kink of `min` short of the minimum by more than tau as far
-//! as its Gauss-Newton step tells ([`super::lsq::gauss_newton_decrease`]), while a round gains
-//! more than tau; damped Newton where it ran out of iterations; line searches along the
-//! covariance's axes (whose scans skip the points where the bounds already exclude chi2 below
-//! U - tau). On many points of many sizes some point is always near its kink, and the kinks
-//! are many and weak: these rules keep the work of such a fit that of any other. The reported
-//! minimum is the lowest polished point, the best grid node only where every polish ended
-//! above it by more than the rounding of the sums (a node and a polish sum chi2 in different
-//! orders). A point below the certified bound would contradict the bounds: a warning, never
-//! ignored.
+//! finished, once per cell of the resolution: for `min`, rounds of Brent on the profiles where
+//! Levenberg-Marquardt ran out of iterations or stopped on a kink short of the minimum by more
+//! than tau as far as its Gauss-Newton step tells ([`super::lsq::gauss_newton_decrease`]),
+//! while a round gains more than tau; for the others, damped Newton where it ran out of
+//! iterations; for all, line searches along the covariance's axes (whose scans skip the points
+//! where the bounds already exclude chi2 below U - tau). On many points of many sizes some
+//! point is always near its kink, and the kinks are many and weak: these rules keep the work
+//! of such a fit that of any other. The reported minimum is the lowest polished point, the best
+//! grid node only where every polish ended above it by more than the rounding of the sums (a
+//! node and a polish sum chi2 in different orders). A point below the certified bound would
+//! contradict the bounds: a warning, never ignored.
 //!
 //! **Costs**: e_vm and e_pm are tabulated once per grid value of eta or sigma_y (a row over all
 //! points, counted as one evaluation); a node of `min` or `product` then costs one min or product
