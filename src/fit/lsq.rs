@@ -602,9 +602,6 @@ mod tests {
         assert_eq!(r.theta[1], 1.0);
     }
 
-    /// Straight line y = c0 + c1 x with sigma = 1: the least-squares covariance is (X^T X)^-1
-    /// in closed form: var(c1) = n / D, var(c0) = sum x^2 / D, cov = -sum x / D,
-    /// D = n sum x^2 - (sum x)^2.
     /// y = c0 + c1 x + c2 * 0 (c2 has no effect: a plateau) with noise, sigma = 1.
     struct Line {
         x: Vec<f64>,
