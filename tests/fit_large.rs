@@ -145,6 +145,32 @@ fn the_wide_registers_change_no_bit() {
     }
 }
 
+/// Fits `min` to `data` (seed `seed`) and checks: converged, certified, no warnings, at most
+/// `max_evaluations` evaluations of the model, and chi2 within 1e-9 relative of `want`.
+fn certified_min_fit(data: &FitData, seed: u64, want: f64, max_evaluations: u64) {
+    let r = fit(data, ModelKind::Min, &FitOptions::default()).unwrap();
+    eprintln!(
+        "seed {seed}: chi2 {:?}, {} evaluations",
+        r.chi2, r.evaluations
+    );
+    assert!(
+        r.converged && r.global.certified,
+        "{seed}: {:?}",
+        r.warnings
+    );
+    assert!(r.warnings.is_empty(), "{seed}: {:?}", r.warnings);
+    assert!(
+        r.evaluations <= max_evaluations,
+        "{seed}: {} evaluations",
+        r.evaluations
+    );
+    assert!(
+        (r.chi2 - want).abs() <= 1e-9 * want,
+        "{seed}: chi2 {} vs {want}",
+        r.chi2
+    );
+}
+
 /// 20 000 points, each on its own pair of sizes (d = 5 mm + i 1e-4 mm on d + 1 mm), speeds
 /// uniform in 0.5-5.5 m/s, e uniform in 0.88-0.90 (no model's truth), e_err 0.02: sigma_y is
 /// bounded from below only, and each pair yields at its own sigma_y, so `min` has a kink per
@@ -184,27 +210,7 @@ fn many_sizes_with_a_flat_yield_stress_end_certified_without_runaway_work() {
         (15, 13087.723123693604),
         (22, 13150.435182455789),
     ] {
-        let r = fit(&many_sizes(seed), ModelKind::Min, &FitOptions::default()).unwrap();
-        eprintln!(
-            "seed {seed}: chi2 {:?}, {} evaluations",
-            r.chi2, r.evaluations
-        );
-        assert!(
-            r.converged && r.global.certified,
-            "{seed}: {:?}",
-            r.warnings
-        );
-        assert!(r.warnings.is_empty(), "{seed}: {:?}", r.warnings);
-        assert!(
-            r.evaluations <= 3000,
-            "{seed}: {} evaluations",
-            r.evaluations
-        );
-        assert!(
-            (r.chi2 - want).abs() <= 1e-9 * want,
-            "{seed}: chi2 {} vs {want}",
-            r.chi2
-        );
+        certified_min_fit(&many_sizes(seed), seed, want, 3000);
     }
 }
 
@@ -243,26 +249,6 @@ fn polydisperse_min_fits_are_certified() {
     // this test's data at 38315a2), to 1e-9 relative as above; 400 evaluations is what a fit of
     // 120 points takes at most.
     for (seed, want) in [(31, 82274.76873660112), (33, 83040.64098876106)] {
-        let r = fit(&polydisperse(seed), ModelKind::Min, &FitOptions::default()).unwrap();
-        eprintln!(
-            "seed {seed}: chi2 {:?}, {} evaluations",
-            r.chi2, r.evaluations
-        );
-        assert!(
-            r.converged && r.global.certified,
-            "{seed}: {:?}",
-            r.warnings
-        );
-        assert!(r.warnings.is_empty(), "{seed}: {:?}", r.warnings);
-        assert!(
-            r.evaluations <= 400,
-            "{seed}: {} evaluations",
-            r.evaluations
-        );
-        assert!(
-            (r.chi2 - want).abs() <= 1e-9 * want,
-            "{seed}: chi2 {} vs {want}",
-            r.chi2
-        );
+        certified_min_fit(&polydisperse(seed), seed, want, 400);
     }
 }

@@ -498,7 +498,7 @@ pub fn levenberg_marquardt(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// y = A exp(-k x) + noise-free data; residuals f = (model - y)/sigma.
@@ -602,23 +602,25 @@ mod tests {
         assert_eq!(r.theta[1], 1.0);
     }
 
-    /// y = c0 + c1 x + c2 * 0 (c2 has no effect: a plateau) with noise, sigma = 1.
-    struct Line {
-        x: Vec<f64>,
-        y: Vec<f64>,
-        lo: Vec<f64>,
-        hi: Vec<f64>,
+    /// y = c0 + c1 x, sigma = 1: a model linear in its parameters (closed-form answers), shared
+    /// with the profile intervals' tests. It has as many parameters as `lo` has entries; those
+    /// beyond c0 and c1 have no effect (a plateau).
+    pub(crate) struct Line {
+        pub x: Vec<f64>,
+        pub y: Vec<f64>,
+        pub lo: Vec<f64>,
+        pub hi: Vec<f64>,
     }
 
     impl Residuals for Line {
         fn n_params(&self) -> usize {
-            3
+            self.lo.len()
         }
         fn n_residuals(&self) -> usize {
             self.x.len()
         }
         fn residuals(&self, t: &[f64], out: &mut [f64]) -> Result<()> {
-            for ((o, x), y) in out.iter_mut().zip(&self.x).zip(&self.y) {
+            for (o, (&x, &y)) in out.iter_mut().zip(self.x.iter().zip(&self.y)) {
                 *o = t[0] + t[1] * x - y;
             }
             Ok(())
@@ -630,7 +632,7 @@ mod tests {
             &self.hi
         }
         fn fd_step(&self) -> f64 {
-            1e-3
+            1e-5
         }
     }
 

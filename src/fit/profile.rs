@@ -242,38 +242,7 @@ fn kept_in_box(x: f64, lo: f64, hi: f64, fallback: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::error::Result;
-
-    /// y = c0 + c1 x, sigma = 1, on x = 0..9 with a fixed non-linear-in-appearance noise.
-    struct Line {
-        x: Vec<f64>,
-        y: Vec<f64>,
-        lo: Vec<f64>,
-        hi: Vec<f64>,
-    }
-    impl Residuals for Line {
-        fn n_params(&self) -> usize {
-            2
-        }
-        fn n_residuals(&self) -> usize {
-            self.x.len()
-        }
-        fn residuals(&self, t: &[f64], out: &mut [f64]) -> Result<()> {
-            for (o, (&x, &y)) in out.iter_mut().zip(self.x.iter().zip(&self.y)) {
-                *o = t[0] + t[1] * x - y;
-            }
-            Ok(())
-        }
-        fn lower(&self) -> &[f64] {
-            &self.lo
-        }
-        fn upper(&self) -> &[f64] {
-            &self.hi
-        }
-        fn fd_step(&self) -> f64 {
-            1e-5
-        }
-    }
+    use crate::fit::lsq::tests::Line;
 
     #[test]
     fn warm_starts_follow_the_line_through_the_two_nearest_points() {
