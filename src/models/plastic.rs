@@ -200,9 +200,72 @@ pub fn e_and_slope_ln_u(u: f64) -> (f64, f64) {
         let dcorr = -t * (A1 + t * (2.0 * A2 + t * 3.0 * A3));
         return (e, e * (dcorr / corr - 0.25));
     }
+    closed_form_slope(u, e, w)
+}
+
+/// The closed form's slope de/d(ln u) from its e and w (u in (1, [`U_ASYMPTOTE`]); written
+/// once, for [`e_and_slope_ln_u`] and [`e_and_slope_ln_u_in_place`]).
+#[inline(always)]
+fn closed_form_slope(u: f64, e: f64, w: f64) -> (f64, f64) {
     let q = 4.0 * (u - 1.0) * (u + 1.0) / (w + 5.0);
     let dlne = u * (4.0 * u / w) * (1.5 / (1.0 + 1.5 * q) - 0.25 / (1.0 + q)) - 1.0;
     (e, e * dlne)
+}
+
+/// [`e_and_slope_ln_u`] in place for many u: `values` holds u on entry and e on return,
+/// `slopes` (as long) receives de/d(ln u); each pair the same doubles as [`e_and_slope_ln_u`]
+/// gives value by value, bit for bit. Why it exists: the fit's Jacobian needs e_pm and its
+/// slope at every point for every step of Levenberg-Marquardt, and one value at a time (a call
+/// the Jacobian's loop did not inline, so compiled without FMA) the closed form's square roots
+/// and divisions wait on each other: four values in the closed form's range go side by side, as
+/// in [`e_of_u_in_place`], four at or below yield are (1, 0) at once, any other group value by
+/// value. A `slopes` shorter than `values` is a caller's bug (a panic, not user input).
+pub fn e_and_slope_ln_u_in_place(values: &mut [f64], slopes: &mut [f64]) {
+    assert_eq!(values.len(), slopes.len(), "one slope per value");
+    #[cfg(target_arch = "x86_64")]
+    if crate::cpu::uses_avx2_fma() {
+        // SAFETY: the processor has the features the function is compiled for.
+        return unsafe { e_and_slope_avx2_fma(values, slopes) };
+    }
+    e_and_slope_lanes(values, slopes)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+unsafe fn e_and_slope_avx2_fma(values: &mut [f64], slopes: &mut [f64]) {
+    e_and_slope_lanes(values, slopes)
+}
+
+/// [`e_and_slope_ln_u_in_place`]'s body (also called directly by the tests, for the baseline
+/// code).
+#[inline(always)]
+pub(crate) fn e_and_slope_lanes(values: &mut [f64], slopes: &mut [f64]) {
+    const LANES: usize = 4;
+    let slopes = &mut slopes[..values.len()];
+    let mut groups = values.chunks_exact_mut(LANES);
+    let mut out = slopes.chunks_exact_mut(LANES);
+    for (g, o) in (&mut groups).zip(&mut out) {
+        let u = [g[0], g[1], g[2], g[3]];
+        if u.iter().all(|&x| x > 1.0 && x < U_ASYMPTOTE) {
+            let r = u.map(|x| {
+                let (e, w) = closed_form(x);
+                closed_form_slope(x, e, w)
+            });
+            for k in 0..LANES {
+                (g[k], o[k]) = r[k];
+            }
+        } else if u.iter().all(|&x| x <= 1.0) {
+            g.fill(1.0);
+            o.fill(0.0);
+        } else {
+            for k in 0..LANES {
+                (g[k], o[k]) = e_and_slope_ln_u(u[k]);
+            }
+        }
+    }
+    for (x, s) in groups.into_remainder().iter_mut().zip(out.into_remainder()) {
+        (*x, *s) = e_and_slope_ln_u(*x);
+    }
 }
 
 /// [`rebound_u`] for unvalidated u: NaN, negative or infinite u is an error naming it.
@@ -367,6 +430,51 @@ mod tests {
         for (k, (x, y)) in a.iter().zip(&b).enumerate() {
             assert_eq!(x.to_bits(), want[k], "baseline, u = {}", us[k]);
             assert_eq!(y.to_bits(), want[k], "dispatched, u = {}", us[k]);
+        }
+    }
+
+    #[test]
+    fn many_slopes_at_once_are_each_value_alone_bit_for_bit() {
+        // As the test above, for e and de/d(ln u) against e_and_slope_ln_u value by value
+        // (NaN compared by its bits too: the same NaN is passed on).
+        let mut us: Vec<f64> = (0..4003)
+            .map(|k| 10f64.powf(-1.0 + 8.0 * (k as f64 * 0.618_034).fract()))
+            .collect();
+        us.extend((0..400).map(|k| 1.0 + 1e-9 * k as f64));
+        us.extend((0..40).map(|k| 0.01 * k as f64));
+        us.extend([
+            f64::NAN,
+            1.0,
+            U_ASYMPTOTE,
+            U_ASYMPTOTE * (1.0 - 1e-16),
+            1e20,
+            f64::MAX,
+            f64::INFINITY,
+            5e-324,
+        ]);
+        let want: Vec<(u64, u64)> = us
+            .iter()
+            .map(|&u| {
+                let (e, s) = e_and_slope_ln_u(u);
+                (e.to_bits(), s.to_bits())
+            })
+            .collect();
+        let (mut a, mut sa) = (us.clone(), vec![0.0; us.len()]);
+        e_and_slope_lanes(&mut a, &mut sa);
+        let (mut b, mut sb) = (us.clone(), vec![0.0; us.len()]);
+        e_and_slope_ln_u_in_place(&mut b, &mut sb);
+        for k in 0..us.len() {
+            let u = us[k];
+            assert_eq!(
+                (a[k].to_bits(), sa[k].to_bits()),
+                want[k],
+                "baseline, u = {u}"
+            );
+            assert_eq!(
+                (b[k].to_bits(), sb[k].to_bits()),
+                want[k],
+                "dispatched, u = {u}"
+            );
         }
     }
 

@@ -2,7 +2,7 @@
 //! coordinates (ln eta, ln sigma_y).
 //!
 //! **Computes** df_i/dtheta_j for f_i = (e_i(model) - e_i)/sigma_i from the slopes of the two
-//! factors ([`master::e_and_slope_master_in_place`], [`plastic::e_and_slope_ln_u`]):
+//! factors ([`master::e_and_slope_master_in_place`], [`plastic::e_and_slope_ln_u_in_place`]):
 //! kappa = eta kappa_1 gives d ln kappa/d ln eta = 1, u = v/(V_Y1 sigma_y^(5/2)) gives
 //! d ln u/d ln sigma_y = -5/2. `product`: the product rule; `min`: the derivative of the smaller
 //! factor (at an exact tie, the mean of the two one-sided derivatives, which is what central
@@ -92,20 +92,23 @@ impl Evaluator<'_> {
             if kind != ModelKind::Pm {
                 self.vm_in_kappa_order(start, eta, &mut ev, slope[0].then_some(&mut sv[..]))?;
             }
+            // e_pm and its slope in ln u (times d ln u/d ln sigma_y = -5/2 below) four points
+            // at a time: the same doubles as point by point.
+            let (mut ep, mut sp) = (vec![1.0; m], vec![0.0; m]);
+            if kind != ModelKind::Vm {
+                for (j, u) in ep.iter_mut().enumerate() {
+                    *u = self.u_s25(start + j, s25);
+                }
+                if slope[1] {
+                    plastic::e_and_slope_ln_u_in_place(&mut ep, &mut sp);
+                } else {
+                    plastic::e_of_u_in_place(&mut ep);
+                }
+            }
             for j in 0..m {
                 let i = start + j;
                 let w = inv_sigma[i];
-                let (ep, sp) = if kind == ModelKind::Vm {
-                    (1.0, 0.0)
-                } else {
-                    let u = self.u_s25(i, s25);
-                    if slope[1] {
-                        let (e, s) = plastic::e_and_slope_ln_u(u);
-                        (e, -2.5 * s)
-                    } else {
-                        (plastic::e_of_u(u), 0.0)
-                    }
-                };
+                let (ep, sp) = (ep[j], -2.5 * sp[j]);
                 let d = match kind {
                     ModelKind::Min if ev[j] < ep => [sv[j], 0.0],
                     ModelKind::Min if ep < ev[j] => [0.0, sp],
