@@ -31,7 +31,9 @@ use super::lsq;
 use super::models::{Evaluator, ModelKind};
 use super::objective::{Objective, check_size};
 use super::polish::{polish_lm, polish_newton};
-use super::profile::{ProfileOutcome, Profiles, Side, profile_intervals};
+use super::profile::{
+    Extension, Moved, ProfileOutcome, Profiles, Side, extend_to_region, profile_intervals,
+};
 use super::result::FitResult;
 use super::search::{SearchOutcome, global_minimum, share_starting_rows};
 use super::sums;
@@ -125,11 +127,25 @@ fn fit_points(
         ));
     }
     let mut profiles = None;
+    let mut moved: Vec<Moved> = Vec::new();
     if options.intervals {
         let mut refits = 0;
         loop {
             let cov = covariance_at(&obj, &best.theta)?;
-            match profile_intervals(&obj, &best.theta, best.chi2, &cov)? {
+            // The ends, moved past the grid nodes of the 95% region the profiles did not reach.
+            let outcome = match profile_intervals(&obj, &best.theta, best.chi2, &cov)? {
+                ProfileOutcome::Done(mut p) => {
+                    match extend_to_region(&obj, best.chi2, &cov, &mut p, &near_nodes)? {
+                        Extension::Done(m) => {
+                            moved = m;
+                            ProfileOutcome::Done(p)
+                        }
+                        Extension::Lower(t) => ProfileOutcome::Lower(t),
+                    }
+                }
+                lower => lower,
+            };
+            match outcome {
                 ProfileOutcome::Done(p) => {
                     profiles = Some(p);
                     break;
@@ -177,6 +193,9 @@ fn fit_points(
         &mut warnings,
     )?;
     if let Some(p) = &profiles {
+        for m in &moved {
+            notes.push(moved_note(&obj, p, m));
+        }
         check_disjoint(&obj, &r, p, &near_nodes, &mut warnings);
     }
     r.converged = converged;
@@ -194,6 +213,28 @@ fn covariance_at(obj: &Objective, theta: &[f64]) -> Result<lsq::Covariance> {
     lsq::residuals_checked(obj, theta, &mut f0)?;
     let jac = lsq::jacobian(obj, theta, &vec![true; theta.len()], &f0)?;
     Ok(lsq::covariance(&jac))
+}
+
+/// The note of an end moved past a point of the 95% region (both values in full, shortest
+/// round-trip; the points' chi2 plus the rows' offset, as the fit's chi2 is printed).
+fn moved_note(obj: &Objective, p: &Profiles, m: &Moved) -> String {
+    let spec = &obj.kind.params()[m.j];
+    let show = |t: f64| Num(if spec.log { t.exp() } else { t });
+    let end = match &p.sides[m.j][m.s] {
+        Side::At(t) => format!("moved to {}", show(*t)),
+        _ => "opened (the profile stays below the threshold to the search box's edge)".into(),
+    };
+    format!(
+        "the {} end of the 95% interval of {} {end}, from {}: the profile from the minimum had \
+         not reached a point of the 95% region there (chi2 = {} at {} = {}); the interval is \
+         the hull of the region found",
+        ["lower", "upper"][m.s],
+        spec.key,
+        show(m.from),
+        Num(m.chi2 + obj.chi2_offset),
+        spec.key,
+        show(m.point[m.j]),
+    )
 }
 
 /// Warns when a grid node inside the 95% threshold lies outside a parameter's interval: the 95%
@@ -228,7 +269,7 @@ fn check_disjoint(
                  threshold {}) at {} = {}",
                 spec.key,
                 crate::error::Num(*c + obj.chi2_offset),
-                crate::error::Num(threshold),
+                crate::error::Num(threshold + obj.chi2_offset),
                 spec.key,
                 crate::error::Num(v)
             ));

@@ -11,7 +11,9 @@
 //! profile passes the threshold or the search box ends (an open side: the parameter is a bound);
 //! then the crossing by Brent's root finder ([`super::scalar::profile_crossing`]). The inner
 //! minimisation is Levenberg-Marquardt warm-started from the nearest profile point already
-//! computed, so a profile follows its valley. A profile point below the minimum reveals a lower
+//! computed, so a profile follows its valley; [`extend_to_region`] then moves an end past any
+//! known point of the 95% region beyond it (the interval is the hull of the region found). A
+//! profile point below the minimum reveals a lower
 //! minimum: the caller refits from it. Every failure is a value: a side whose crossing could
 //! not be found is [`Side::Lost`] with the reason, and inner minimisations that did not converge
 //! are counted (their profile values are upper bounds, so the interval could be too short).
@@ -79,7 +81,8 @@ pub fn profile_intervals_of(
         .filter(|&j| !cov.degenerate[j])
         .flat_map(|j| [(j, 0), (j, 1)])
         .collect();
-    let end = |&(j, s): &(usize, usize)| profile_end(obj, theta, chi2_min, cov, delta, j, s);
+    let end =
+        |&(j, s): &(usize, usize)| profile_end(obj, (theta, chi2_min), chi2_min, cov, delta, j, s);
     // Each end is its own profile (warm-started from its own points only), so large data's
     // ends run side by side (a fit's profiles are a fifth of its time, and the last fit of
     // `--model all` otherwise runs its profiles on one core while the other waits) and give
@@ -118,16 +121,19 @@ enum End {
     Lower(Vec<f64>),
 }
 
-/// The end `s` (0 lower, 1 upper) of parameter j's interval (see the module doc).
+/// The end `s` (0 lower, 1 upper) of parameter j's interval (see the module doc), searched
+/// outwards from `from` = (theta, chi2), a point below the threshold chi2_min + delta: the
+/// minimum, or a point of the 95% region beyond an end already found ([`extend_to_region`]).
 fn profile_end(
     obj: &impl Residuals,
-    theta: &[f64],
+    from: (&[f64], f64),
     chi2_min: f64,
     cov: &Covariance,
     delta: f64,
     j: usize,
     s: usize,
 ) -> Result<End> {
+    let (theta, chi2_from) = from;
     let k = obj.n_params();
     let threshold = chi2_min + delta;
     // A profile point this far below the minimum means a missed minimum, not rounding.
@@ -171,7 +177,7 @@ fn profile_end(
         Ok(c)
     };
     // Crossings to 1e-7 in the internal coordinate (log parameters: 1e-7 relative).
-    let c = profile_crossing(profile, theta[j], chi2_min, limit, step, threshold, 1e-7)?;
+    let c = profile_crossing(profile, theta[j], chi2_from, limit, step, threshold, 1e-7)?;
     if let Some(t) = lower_found.into_inner() {
         return Ok(End::Lower(t));
     }
@@ -181,6 +187,85 @@ fn profile_end(
         Crossing::Failed(why) => Side::Lost(why),
     };
     Ok(End::Side(side, failed_inner.get()))
+}
+
+/// An end of an interval moved past a point of the 95% region that the profile from the
+/// minimum had not reached ([`extend_to_region`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Moved {
+    /// The parameter and the end (0 lower, 1 upper).
+    pub j: usize,
+    pub s: usize,
+    /// The end before, in internal coordinates.
+    pub from: f64,
+    /// The point passed: its parameters (internal coordinates) and chi2.
+    pub point: Vec<f64>,
+    pub chi2: f64,
+}
+
+/// What [`extend_to_region`] did.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Extension {
+    /// The ends moved (each end of `Profiles` now lies beyond every point given below the
+    /// threshold, or is where it was with a side the search could not extend: Lost or Open).
+    Done(Vec<Moved>),
+    /// A profile point below the minimum: the caller refits from it.
+    Lower(Vec<f64>),
+}
+
+/// Moves each found end of `p` past the points of `inside` (parameters in internal coordinates,
+/// chi2 as the objective's) that lie below the threshold chi2_min + delta but beyond the end
+/// (by more than 1e-6, above the crossings' tolerance): the 95% region is
+/// {t : P_j(t) <= threshold}, and such a point shows P_j <= its chi2 there, so the interval must
+/// reach it. Why it is needed: the profile from the minimum follows one valley (its inner
+/// minimisation is local), and the region can have a part it does not reach, beyond a ridge of
+/// the profile (a second valley) or where the inner minimisation stopped on a plateau of the
+/// other parameter. The interval reported is then the hull of what is known of the region
+/// (conservative: the region need not be connected). From the farthest such point, the
+/// profile is searched outwards as from the minimum (warm-started there); an
+/// end it cannot find stays where it was (the caller's check then warns).
+pub fn extend_to_region(
+    obj: &(impl Residuals + Sync),
+    chi2_min: f64,
+    cov: &Covariance,
+    p: &mut Profiles,
+    inside: &[(Vec<f64>, f64)],
+) -> Result<Extension> {
+    let threshold = chi2_min + p.delta;
+    let mut moved = Vec::new();
+    for j in 0..p.sides.len() {
+        for s in 0..2 {
+            let Side::At(end) = p.sides[j][s] else {
+                continue;
+            };
+            let dir = if s == 0 { -1.0 } else { 1.0 };
+            let beyond = |th: &Vec<f64>| (th[j] - end) * dir > 1e-6;
+            let Some((th, c)) = inside
+                .iter()
+                .filter(|(th, c)| *c < threshold && th.len() == p.sides.len() && beyond(th))
+                .max_by(|a, b| ((a.0[j] - b.0[j]) * dir).total_cmp(&0.0))
+            else {
+                continue;
+            };
+            match profile_end(obj, (th, *c), chi2_min, cov, p.delta, j, s)? {
+                End::Lower(t) => return Ok(Extension::Lower(t)),
+                End::Side(side, failed) => {
+                    p.unconverged[j] += failed;
+                    if matches!(side, Side::At(_) | Side::Open) {
+                        p.sides[j][s] = side;
+                        moved.push(Moved {
+                            j,
+                            s,
+                            from: end,
+                            point: th.clone(),
+                            chi2: *c,
+                        });
+                    }
+                }
+            }
+        }
+    }
+    Ok(Extension::Done(moved))
 }
 
 /// The start of the inner minimisation at t when only the minimum is known: the other
@@ -243,6 +328,96 @@ fn kept_in_box(x: f64, lo: f64, hi: f64, fallback: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::fit::lsq::tests::Line;
+
+    /// chi2(t) = min(t^2, (t - 6)^2 + 1) on [-20, hi]: two valleys, the second's part of the
+    /// 95% region (chi2 <= 3.84) is [6 - sqrt(2.84), 6 + sqrt(2.84)], beyond a ridge the
+    /// profile from the minimum at t = 0 does not cross.
+    struct TwoValleys {
+        lo: [f64; 1],
+        hi: [f64; 1],
+    }
+
+    impl Residuals for TwoValleys {
+        fn n_params(&self) -> usize {
+            1
+        }
+        fn n_residuals(&self) -> usize {
+            1
+        }
+        fn residuals(&self, t: &[f64], out: &mut [f64]) -> Result<()> {
+            let x = t[0];
+            out[0] = (x * x).min((x - 6.0).powi(2) + 1.0).sqrt();
+            Ok(())
+        }
+        fn lower(&self) -> &[f64] {
+            &self.lo
+        }
+        fn upper(&self) -> &[f64] {
+            &self.hi
+        }
+        fn fd_step(&self) -> f64 {
+            1e-6
+        }
+    }
+
+    #[test]
+    fn an_end_moves_past_a_part_of_the_region_beyond_a_ridge() {
+        // Closed forms: the first valley's ends +-sqrt(3.84), the second's upper end
+        // 6 + sqrt(2.84); crossings are found to 1e-7 in t, so 1e-6 covers them.
+        let cov = Covariance {
+            matrix: nalgebra::DMatrix::from_element(1, 1, 1.0),
+            no_effect: vec![false],
+            degenerate: vec![false],
+        };
+        let at = |side: &Side| match side {
+            Side::At(t) => *t,
+            other => panic!("{other:?}"),
+        };
+        let problem = TwoValleys {
+            lo: [-20.0],
+            hi: [20.0],
+        };
+        let ProfileOutcome::Done(mut p) =
+            profile_intervals_of(&problem, &[0.0], 0.0, &cov, 1.0).unwrap()
+        else {
+            panic!("no lower minimum here");
+        };
+        let half = CHI2_1DOF_95.sqrt();
+        assert!((at(&p.sides[0][0]) + half).abs() < 1e-6, "{:?}", p.sides);
+        assert!((at(&p.sides[0][1]) - half).abs() < 1e-6, "{:?}", p.sides);
+        // Points inside the interval or above the threshold move nothing; the second valley's
+        // minimum (chi2 1 at t = 6) moves the upper end to that valley's far crossing.
+        let inside = [
+            (vec![-1.0], 1.0),
+            (vec![3.0], 9.0),
+            (vec![6.0], 1.0),
+            (vec![5.0], 2.0),
+        ];
+        let Extension::Done(moved) =
+            extend_to_region(&problem, 0.0, &cov, &mut p, &inside).unwrap()
+        else {
+            panic!("no lower minimum here");
+        };
+        assert!((at(&p.sides[0][0]) + half).abs() < 1e-6, "{:?}", p.sides);
+        let far = 6.0 + (CHI2_1DOF_95 - 1.0).sqrt();
+        assert!((at(&p.sides[0][1]) - far).abs() < 1e-6, "{:?}", p.sides);
+        assert_eq!(moved.len(), 1);
+        let m = &moved[0];
+        assert_eq!((m.j, m.s, m.point.clone(), m.chi2), (0, 1, vec![6.0], 1.0));
+        assert!((m.from - half).abs() < 1e-6);
+        // With the box ending inside the second valley's part the end opens.
+        let problem = TwoValleys {
+            lo: [-20.0],
+            hi: [7.0],
+        };
+        let ProfileOutcome::Done(mut p) =
+            profile_intervals_of(&problem, &[0.0], 0.0, &cov, 1.0).unwrap()
+        else {
+            panic!("no lower minimum here");
+        };
+        extend_to_region(&problem, 0.0, &cov, &mut p, &inside).unwrap();
+        assert_eq!(p.sides[0][1], Side::Open);
+    }
 
     #[test]
     fn warm_starts_follow_the_line_through_the_two_nearest_points() {
