@@ -1,0 +1,180 @@
+//! Do the 95% profile intervals of `min` and `product` reach as far as the 95% region? An
+//! independent check: beyond each end an interval has, the profile is computed by brute force
+//! (the other parameter on a dense log grid over the fit's search box, chi2 summed from the
+//! library's model functions alone) and any point below the threshold chi2_min + Delta is a
+//! part of the region the interval misses.
+//!
+//! ```text
+//! cargo run --release --example interval_scan -- FROM TO   # seeds FROM..TO (default 0..100)
+//! cargo run --release --example interval_scan -- --moved FROM TO
+//! ```
+//!
+//! `--moved` only counts, over every model's fit (`fit_all`), the ends moved past a grid node of
+//! the 95% region (the fits' notes) and the parts of the region still outside an interval (their
+//! warnings): fast, no brute force.
+//!
+//! The data sets are the randomized global-minimum test's (`examples/fit_global/cases.rs`).
+//! Probes: at distances 0.001 w and 2k/30 w (k = 1..30) beyond the end in the log parameter,
+//! w = |ln(end / best)| (at least 1e-4), inside the box; the brute-force profile at each is the
+//! least chi2 over 3000 log-spaced values of the other parameter across its box. The grid can
+//! only find points of the region (an upper bound of the profile), never invent them: each one
+//! printed is a point the fit's interval should have reached. Quoted in the README (known
+//! limitations).
+
+#[path = "fit_global/cases.rs"]
+#[allow(dead_code)]
+mod cases;
+
+use restitution::fit::models::{Evaluator, predict_e};
+use restitution::fit::objective::Objective;
+use restitution::fit::{FitOptions, ModelKind, fit};
+use restitution::models::viscoelastic::VmMethod;
+
+fn main() {
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let moved_only = args.first().is_some_and(|a| a == "--moved");
+    if moved_only {
+        args.remove(0);
+    }
+    let args: Vec<u64> = args
+        .into_iter()
+        .map(|a| {
+            a.parse().unwrap_or_else(|_| {
+                eprintln!("interval_scan: seeds are whole numbers, not '{a}'");
+                std::process::exit(2)
+            })
+        })
+        .collect();
+    let (from, to) = match args[..] {
+        [] => (0, 100),
+        [a, b] => (a, b),
+        _ => {
+            eprintln!("interval_scan: give FROM TO or nothing");
+            std::process::exit(2)
+        }
+    };
+    if moved_only {
+        count_moved(from, to);
+        return;
+    }
+    let (mut fits, mut ends, mut short) = (0, 0, 0);
+    for seed in from..to {
+        let c = cases::make_case(seed);
+        let d = &c.data;
+        for kind in [ModelKind::Min, ModelKind::Product] {
+            let options = FitOptions {
+                rule: c.rule,
+                ..FitOptions::default()
+            };
+            let Ok(r) = fit(d, kind, &options) else {
+                continue;
+            };
+            fits += 1;
+            let ev = Evaluator::new(d, c.rule, VmMethod::Master);
+            let Ok(obj) = Objective::new(&ev, kind) else {
+                continue;
+            };
+            let chi2 = |p: [f64; 2]| -> f64 {
+                (0..d.len())
+                    .map(|i| {
+                        let e = predict_e(
+                            kind,
+                            &d.contacts[i],
+                            d.obs[i].v_n_m_s,
+                            &p,
+                            c.rule,
+                            &VmMethod::Master,
+                        )
+                        .unwrap_or(f64::NAN);
+                        ((e - d.obs[i].e) / d.sigma(i)).powi(2)
+                    })
+                    .sum()
+            };
+            let threshold = r.chi2 + r.ci95_delta_chi2;
+            for j in 0..2 {
+                let other = 1 - j;
+                let (olo, ohi) = (obj.lower[other], obj.upper[other]);
+                let profile = |t: f64| -> (f64, f64) {
+                    let m = 3000;
+                    (0..=m)
+                        .map(|k| {
+                            let y = olo + (ohi - olo) * k as f64 / m as f64;
+                            let p = if j == 0 { [t, y] } else { [y, t] };
+                            (chi2(p.map(f64::exp)), y)
+                        })
+                        .fold((f64::INFINITY, 0.0), |a, b| if b.0 < a.0 { b } else { a })
+                };
+                let best = r.theta[j];
+                for (s, end) in [(0, r.params[j].ci95.0), (1, r.params[j].ci95.1)] {
+                    let Some(end) = end else { continue };
+                    ends += 1;
+                    let end = end.ln();
+                    let dir = if s == 0 { -1.0 } else { 1.0 };
+                    let w = (end - best).abs().max(1e-4);
+                    let beyond = std::iter::once(0.001)
+                        .chain((1..=30).map(|k| 2.0 * k as f64 / 30.0))
+                        .map(|f| end + dir * w * f)
+                        .filter(|t| *t >= obj.lower[j] && *t <= obj.upper[j]);
+                    let found = beyond
+                        .map(|t| (t, profile(t)))
+                        .filter(|(_, (v, _))| *v < threshold)
+                        .max_by(|a, b| ((a.0 - b.0) * dir).total_cmp(&0.0));
+                    if let Some((t, (v, y))) = found {
+                        short += 1;
+                        println!(
+                            "seed {seed} {}: the {} end of {} ({:e}) is short: chi2 {v:?} below \
+                             the threshold {threshold:?} at {} = {:e} ({} = {:e})",
+                            kind.name(),
+                            ["lower", "upper"][s],
+                            kind.params()[j].key,
+                            end.exp(),
+                            kind.params()[j].key,
+                            t.exp(),
+                            kind.params()[other].key,
+                            y.exp(),
+                        );
+                    }
+                }
+            }
+        }
+    }
+    println!(
+        "seeds {from}..{to}: {fits} fits of min and product, {ends} interval ends, {short} short \
+         of the 95% region"
+    );
+}
+
+/// The `--moved` count (see the module doc).
+fn count_moved(from: u64, to: u64) {
+    let kinds = [
+        ModelKind::Vm,
+        ModelKind::Pm,
+        ModelKind::Min,
+        ModelKind::Product,
+        ModelKind::PowerLaw,
+    ];
+    let (mut fits, mut moved, mut outside) = (0, 0, 0);
+    for seed in from..to {
+        let c = cases::make_case(seed);
+        let options = FitOptions {
+            rule: c.rule,
+            ..FitOptions::default()
+        };
+        let Ok(set) = restitution::fit::fit_all(&c.data, &kinds, &options) else {
+            continue;
+        };
+        for r in &set.fits {
+            fits += 1;
+            moved += r.notes.iter().filter(|n| n.contains("95% region")).count();
+            outside += r
+                .warnings
+                .iter()
+                .filter(|w| w.contains("has a part outside the interval"))
+                .count();
+        }
+    }
+    println!(
+        "seeds {from}..{to}: {fits} fits, {moved} interval ends moved past a grid node of the 95% \
+         region, {outside} parts of the region still outside an interval"
+    );
+}
