@@ -373,15 +373,18 @@ mod tests {
             Side::At(t) => *t,
             other => panic!("{other:?}"),
         };
+        let intervals =
+            |problem: &TwoValleys| match profile_intervals_of(problem, &[0.0], 0.0, &cov, 1.0)
+                .unwrap()
+            {
+                ProfileOutcome::Done(p) => p,
+                other => panic!("no lower minimum here: {other:?}"),
+            };
         let problem = TwoValleys {
             lo: [-20.0],
             hi: [20.0],
         };
-        let ProfileOutcome::Done(mut p) =
-            profile_intervals_of(&problem, &[0.0], 0.0, &cov, 1.0).unwrap()
-        else {
-            panic!("no lower minimum here");
-        };
+        let mut p = intervals(&problem);
         let half = CHI2_1DOF_95.sqrt();
         assert!((at(&p.sides[0][0]) + half).abs() < 1e-6, "{:?}", p.sides);
         assert!((at(&p.sides[0][1]) - half).abs() < 1e-6, "{:?}", p.sides);
@@ -410,11 +413,7 @@ mod tests {
             lo: [-20.0],
             hi: [7.0],
         };
-        let ProfileOutcome::Done(mut p) =
-            profile_intervals_of(&problem, &[0.0], 0.0, &cov, 1.0).unwrap()
-        else {
-            panic!("no lower minimum here");
-        };
+        let mut p = intervals(&problem);
         extend_to_region(&problem, 0.0, &cov, &mut p, &inside).unwrap();
         assert_eq!(p.sides[0][1], Side::Open);
     }

@@ -402,41 +402,10 @@ mod tests {
         }
     }
 
-    #[test]
-    fn many_values_at_once_are_each_value_alone_bit_for_bit() {
-        // Groups of four wholly in the closed form's range, wholly at or below yield, and mixed
-        // ones (yield, the asymptote's hand-over, NaN, inf, subnormal), plus a tail shorter
-        // than a group; the baseline code and the dispatching one (AVX2 and FMA where the
-        // processor has them) against e_of_u value by value.
-        let mut us: Vec<f64> = (0..4003)
-            .map(|k| 10f64.powf(-1.0 + 8.0 * (k as f64 * 0.618_034).fract()))
-            .collect();
-        us.extend((0..400).map(|k| 1.0 + 1e-9 * k as f64));
-        us.extend((0..40).map(|k| 0.01 * k as f64));
-        us.extend([
-            f64::NAN,
-            1.0,
-            U_ASYMPTOTE,
-            U_ASYMPTOTE * (1.0 - 1e-16),
-            f64::MAX,
-            f64::INFINITY,
-            5e-324,
-        ]);
-        let want: Vec<u64> = us.iter().map(|&u| e_of_u(u).to_bits()).collect();
-        let mut a = us.clone();
-        e_of_u_lanes(&mut a);
-        let mut b = us.clone();
-        e_of_u_in_place(&mut b);
-        for (k, (x, y)) in a.iter().zip(&b).enumerate() {
-            assert_eq!(x.to_bits(), want[k], "baseline, u = {}", us[k]);
-            assert_eq!(y.to_bits(), want[k], "dispatched, u = {}", us[k]);
-        }
-    }
-
-    #[test]
-    fn many_slopes_at_once_are_each_value_alone_bit_for_bit() {
-        // As the test above, for e and de/d(ln u) against e_and_slope_ln_u value by value
-        // (NaN compared by its bits too: the same NaN is passed on).
+    /// The u of the many-value tests: groups of four wholly in the closed form's range, wholly
+    /// at or below yield, and mixed ones (yield, the asymptote's hand-over, the slope's switch at
+    /// 1e20, NaN, inf, subnormal), plus a tail shorter than a group.
+    fn grouped_us() -> Vec<f64> {
         let mut us: Vec<f64> = (0..4003)
             .map(|k| 10f64.powf(-1.0 + 8.0 * (k as f64 * 0.618_034).fract()))
             .collect();
@@ -452,6 +421,32 @@ mod tests {
             f64::INFINITY,
             5e-324,
         ]);
+        us
+    }
+
+    #[test]
+    fn many_values_at_once_are_each_value_alone_bit_for_bit() {
+        // Groups of four wholly in the closed form's range, wholly at or below yield, and mixed
+        // ones (yield, the asymptote's hand-over, NaN, inf, subnormal), plus a tail shorter
+        // than a group; the baseline code and the dispatching one (AVX2 and FMA where the
+        // processor has them) against e_of_u value by value.
+        let us = grouped_us();
+        let want: Vec<u64> = us.iter().map(|&u| e_of_u(u).to_bits()).collect();
+        let mut a = us.clone();
+        e_of_u_lanes(&mut a);
+        let mut b = us.clone();
+        e_of_u_in_place(&mut b);
+        for (k, (x, y)) in a.iter().zip(&b).enumerate() {
+            assert_eq!(x.to_bits(), want[k], "baseline, u = {}", us[k]);
+            assert_eq!(y.to_bits(), want[k], "dispatched, u = {}", us[k]);
+        }
+    }
+
+    #[test]
+    fn many_slopes_at_once_are_each_value_alone_bit_for_bit() {
+        // As the test above, for e and de/d(ln u) against e_and_slope_ln_u value by value
+        // (NaN compared by its bits too: the same NaN is passed on).
+        let us = grouped_us();
         let want: Vec<(u64, u64)> = us
             .iter()
             .map(|&u| {
