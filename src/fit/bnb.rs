@@ -174,6 +174,16 @@ enum Split {
     Finest,
 }
 
+/// A cell of the grid ([`Bnb::cells_below`]): the dyadic positions of its corners, and their
+/// internal coordinates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CellBox {
+    pub p0: [u64; 2],
+    pub p1: [u64; 2],
+    pub t0: [f64; 2],
+    pub t1: [f64; 2],
+}
+
 /// Budgets of a [`Bnb`].
 #[derive(Debug, Clone, Copy)]
 pub struct Limits {
@@ -193,6 +203,10 @@ pub struct Bnb<L: Landscape> {
     done: Vec<Cell>,
     /// Cells that could not be resolved, with the reason.
     unresolved: Vec<(Cell, String)>,
+    /// Cells set aside with a bound above U but at most `keep_of(U)` ([`Bnb::refine`]): with
+    /// the others they cover every point of the box that may have chi2 that low
+    /// ([`Bnb::cells_below`]).
+    kept: Vec<Cell>,
     /// Cells left at the statistical resolution ([`Bnb::set_resolution`]) with a bound below
     /// U - tau: they surround the minima, where local polishes take over.
     fine: Vec<Cell>,
@@ -221,11 +235,9 @@ pub fn starting_rows(range: (f64, f64), n0: u64) -> Vec<f64> {
 }
 
 impl<L: Landscape> Bnb<L> {
-    /// A uniform starting grid of `n0[k]` cells over `range[k]` (an axis with `n0 = 0` is
-    /// inactive: one row at its `lo`). Evaluates every starting node, and bounds every starting
-    /// cell (by blocks of cells where a block's bound decides them: see the module doc).
-    pub fn new(land: L, range: [(f64, f64); 2], n0: [u64; 2], limits: Limits) -> Self {
-        let mut b = Bnb {
+    /// No node or cell yet.
+    fn empty(land: L, range: [(f64, f64); 2], n0: [u64; 2], limits: Limits) -> Self {
+        Bnb {
             land,
             axes: [Axis::new(range[0], n0[0]), Axis::new(range[1], n0[1])],
             nodes: Map::default(),
@@ -233,6 +245,7 @@ impl<L: Landscape> Bnb<L> {
             heap: BinaryHeap::new(),
             done: Vec::new(),
             unresolved: Vec::new(),
+            kept: Vec::new(),
             fine: Vec::new(),
             resolution: [0.0, 0.0],
             start_cells: Vec::new(),
@@ -241,7 +254,14 @@ impl<L: Landscape> Bnb<L> {
             started: false,
             target: f64::INFINITY,
             row_failures: Vec::new(),
-        };
+        }
+    }
+
+    /// A uniform starting grid of `n0[k]` cells over `range[k]` (an axis with `n0 = 0` is
+    /// inactive: one row at its `lo`). Evaluates every starting node, and bounds every starting
+    /// cell (by blocks of cells where a block's bound decides them: see the module doc).
+    pub fn new(land: L, range: [(f64, f64); 2], n0: [u64; 2], limits: Limits) -> Self {
+        let mut b = Bnb::empty(land, range, n0, limits);
         let step = |k: usize, b: &Self| if b.axes[k].active { 1u64 << DEPTH } else { 0 };
         let (s0, s1) = (step(0, &b), step(1, &b));
         let (c0, c1) = (
@@ -292,6 +312,29 @@ impl<L: Landscape> Bnb<L> {
             }
         }
         b.start_cells = cells.into_iter().flatten().collect();
+        b
+    }
+
+    /// As [`Bnb::new`], but starting from the cells `cells` (dyadic corner positions on the
+    /// grid `new` would build over the same `range` and `n0`) instead of the whole uniform grid:
+    /// the rest of the box is known not to matter (for example a slice of another branch and
+    /// bound's box, [`Bnb::cells_below`]). Not for [`Bnb::initial_minima`], which reads the
+    /// uniform grid.
+    pub fn on_cells(
+        land: L,
+        range: [(f64, f64); 2],
+        n0: [u64; 2],
+        cells: &[([u64; 2], [u64; 2])],
+        limits: Limits,
+    ) -> Self {
+        let mut b = Bnb::empty(land, range, n0, limits);
+        let corners: Vec<[u64; 2]> = cells
+            .iter()
+            .flat_map(|&(p0, p1)| [p0, [p1[0], p0[1]], [p0[0], p1[1]], p1])
+            .collect();
+        b.nodes_at(&corners);
+        b.target = b.best.map_or(f64::INFINITY, |(_, v)| v);
+        b.start_cells = cells.iter().map(|&(p0, p1)| b.make_cell(p0, p1)).collect();
         b
     }
 
@@ -495,8 +538,14 @@ impl<L: Landscape> Bnb<L> {
 
     /// Splits cells until every remaining one has a bound of at least U - tau, with U the lower
     /// of `upper` and the best node so far (tau recomputed from U by `tau_of`), or is at the
-    /// resolution, or the budget runs out.
-    pub fn refine(&mut self, upper: f64, tau_of: &dyn Fn(f64) -> f64) {
+    /// resolution, or the budget runs out. Cells whose bound exceeds U are dropped, but kept
+    /// aside where it is at most `keep_of(U)` (`|u| u` keeps none).
+    pub fn refine(
+        &mut self,
+        upper: f64,
+        tau_of: &dyn Fn(f64) -> f64,
+        keep_of: &dyn Fn(f64) -> f64,
+    ) {
         let pending: Vec<Cell> = if self.started {
             std::mem::take(&mut self.done)
         } else {
@@ -505,7 +554,7 @@ impl<L: Landscape> Bnb<L> {
         };
         let u_of = |s: &Self| s.best.map_or(upper, |(_, b)| b.min(upper));
         for c in pending {
-            self.push(c, u_of(self), tau_of);
+            self.push(c, u_of(self), tau_of, keep_of);
         }
         while let Some(ByBound(cell)) = self.heap.pop() {
             let u = u_of(self);
@@ -535,12 +584,12 @@ impl<L: Landscape> Bnb<L> {
                 }
             };
             for c in children {
-                self.push(c, u_of(self), tau_of);
+                self.push(c, u_of(self), tau_of, keep_of);
             }
         }
     }
 
-    fn push(&mut self, c: Cell, u: f64, tau_of: &dyn Fn(f64) -> f64) {
+    fn push(&mut self, c: Cell, u: f64, tau_of: &dyn Fn(f64) -> f64, keep_of: &dyn Fn(f64) -> f64) {
         if c.failed {
             let why = self
                 .row_failures
@@ -553,6 +602,8 @@ impl<L: Landscape> Bnb<L> {
             self.heap.push(ByBound(c));
         } else if c.bound.lb <= u {
             self.done.push(c);
+        } else if c.bound.lb <= keep_of(u) {
+            self.kept.push(c);
         }
     }
 
@@ -637,6 +688,27 @@ impl<L: Landscape> Bnb<L> {
             .chain(self.unresolved.iter().map(|(c, _)| c))
             .chain(self.heap.iter().map(|b| &b.0))
             .any(|c| !(c.bound.lb >= target) && inside(c))
+    }
+
+    /// Every cell whose bound is below `below`, for `below` at most `keep_of(U)` of the last
+    /// [`Bnb::refine`]: no other point of the box has chi2 below it (every cell not listed was
+    /// dropped with a bound above it, or was kept, set aside or split with one at least U - tau
+    /// for a U at least the current one; both grow with U).
+    pub fn cells_below(&self, below: f64) -> Vec<CellBox> {
+        self.done
+            .iter()
+            .chain(&self.fine)
+            .chain(&self.kept)
+            .chain(self.unresolved.iter().map(|(c, _)| c))
+            .chain(self.heap.iter().map(|b| &b.0))
+            .filter(|c| !(c.bound.lb >= below))
+            .map(|c| CellBox {
+                p0: c.p0,
+                p1: c.p1,
+                t0: [0, 1].map(|k| self.axes[k].t_at(c.p0[k])),
+                t1: [0, 1].map(|k| self.axes[k].t_at(c.p1[k])),
+            })
+            .collect()
     }
 
     /// How many cells were left at the resolution with a bound below `target`.

@@ -32,7 +32,8 @@ use super::models::{Evaluator, ModelKind};
 use super::objective::{Objective, check_size};
 use super::polish::{polish_lm, polish_newton};
 use super::profile::{
-    Extension, Moved, ProfileOutcome, Profiles, Side, extend_to_region, profile_intervals,
+    Extension, Moved, ProfileOutcome, Profiles, Side, extend_to_region, global_inner,
+    profile_intervals_of,
 };
 use super::result::FitResult;
 use super::search::{SearchOutcome, global_minimum, share_starting_rows};
@@ -116,6 +117,7 @@ fn fit_points(
         global,
         mut warnings,
         near_nodes,
+        region,
     } = search;
     warnings.splice(0..0, obj.warnings.iter().cloned());
     let mut notes = Vec::new();
@@ -133,18 +135,22 @@ fn fit_points(
         loop {
             let cov = covariance_at(&obj, &best.theta)?;
             // The ends, moved past the grid nodes of the 95% region the profiles did not reach.
-            let outcome = match profile_intervals(&obj, &best.theta, best.chi2, &cov)? {
-                ProfileOutcome::Done(mut p) => {
-                    match extend_to_region(&obj, best.chi2, &cov, &mut p, &near_nodes)? {
-                        Extension::Done(m) => {
-                            moved = m;
-                            ProfileOutcome::Done(p)
+            let inner = global_inner(&obj, region.as_ref());
+            let inner = inner.as_deref();
+            let scale = obj.scale(best.chi2);
+            let outcome =
+                match profile_intervals_of(&obj, &best.theta, best.chi2, &cov, scale, inner)? {
+                    ProfileOutcome::Done(mut p) => {
+                        match extend_to_region(&obj, best.chi2, &cov, &mut p, &near_nodes, inner)? {
+                            Extension::Done(m) => {
+                                moved = m;
+                                ProfileOutcome::Done(p)
+                            }
+                            Extension::Lower(t) => ProfileOutcome::Lower(t),
                         }
-                        Extension::Lower(t) => ProfileOutcome::Lower(t),
                     }
-                }
-                lower => lower,
-            };
+                    lower => lower,
+                };
             match outcome {
                 ProfileOutcome::Done(p) => {
                     profiles = Some(p);

@@ -18,6 +18,7 @@ pub mod qp;
 pub mod result;
 pub mod scalar;
 pub mod search;
+pub mod slice;
 pub mod sums;
 pub mod vexp;
 pub mod walton;

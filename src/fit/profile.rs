@@ -11,10 +11,12 @@
 //! profile passes the threshold or the search box ends (an open side: the parameter is a bound);
 //! then the crossing by Brent's root finder ([`super::scalar::profile_crossing`]). The inner
 //! minimisation is Levenberg-Marquardt warm-started from the nearest profile point already
-//! computed, so a profile follows its valley; [`extend_to_region`] then moves an end past any
-//! known point of the 95% region beyond it (the interval is the hull of the region found). A
-//! profile point below the minimum reveals a lower
-//! minimum: the caller refits from it. Every failure is a value: a side whose crossing could
+//! computed, so a profile follows its valley; where its value is at or above the threshold, an
+//! [`Inner`] given (the fit's, for `min` and `product`: [`super::slice`]) shows it is the
+//! profile's or finds a lower point (a value below the threshold needs no check: the profile is
+//! at most that). [`extend_to_region`] then moves an end past any known point of the 95% region
+//! beyond it (the interval is the hull of the region found). A profile point below the minimum
+//! reveals a lower minimum: the caller refits from it. Every failure is a value: a side whose crossing could
 //! not be found is [`Side::Lost`] with the reason, and inner minimisations that did not converge
 //! are counted (their profile values are upper bounds, so the interval could be too short).
 //!
@@ -22,8 +24,11 @@
 //! the least-squares value +- sqrt(3.84) standard errors.
 
 use super::lsq::{self, Covariance, LmOptions, Residuals};
+use super::models::ModelKind;
 use super::objective::{CHI2_1DOF_95, Objective};
 use super::scalar::{Crossing, profile_crossing};
+use super::search::Region;
+use super::slice::slice_minimum;
 use super::sums;
 use crate::error::Result;
 use std::cell::{Cell, RefCell};
@@ -55,23 +60,39 @@ pub enum ProfileOutcome {
     Lower(Vec<f64>),
 }
 
-/// The profile-likelihood intervals around the minimum `theta` (chi2 `chi2_min`).
-pub fn profile_intervals(
-    obj: &Objective,
-    theta: &[f64],
-    chi2_min: f64,
-    cov: &Covariance,
-) -> Result<ProfileOutcome> {
-    profile_intervals_of(obj, theta, chi2_min, cov, obj.scale(chi2_min))
+/// A global inner minimisation: for parameter j held at t, the local minimisation's point and
+/// chi2 there and a target, a point with theta_j = t at least as low, its chi2, and whether it
+/// is shown that no point with theta_j = t has chi2 below the lower of that chi2 and the target
+/// (by more than the search's tolerance: [`super::slice`]).
+pub type Inner<'a> =
+    dyn Fn(usize, f64, (&[f64], f64), f64) -> Result<(Vec<f64>, f64, bool)> + Sync + 'a;
+
+/// The global inner minimisation of `obj`'s profiles, where it has one: `min` and `product`,
+/// whose chi2 over one parameter with the other held can have several minima (a plateau where
+/// every point stays elastic, the kinks of `min`), with the global search's `region`.
+pub fn global_inner<'a>(
+    obj: &'a Objective<'a>,
+    region: Option<&'a Region>,
+) -> Option<Box<Inner<'a>>> {
+    let region = region?;
+    if !matches!(obj.kind, ModelKind::Min | ModelKind::Product) {
+        return None;
+    }
+    Some(Box::new(move |j, t, local, target| {
+        let m = slice_minimum(obj, j, t, local, target, region)?;
+        Ok((m.theta, m.chi2, m.certified))
+    }))
 }
 
-/// As [`profile_intervals`] for any problem, with the chi2 scale given.
+/// The profile-likelihood intervals around the minimum `theta` (chi2 `chi2_min`), with the chi2
+/// scale given, the inner minimisation completed by `inner` where given (the fit's: [`global_inner`]).
 pub fn profile_intervals_of(
     obj: &(impl Residuals + Sync),
     theta: &[f64],
     chi2_min: f64,
     cov: &Covariance,
     scale: f64,
+    inner: Option<&Inner>,
 ) -> Result<ProfileOutcome> {
     let k = obj.n_params();
     let delta = CHI2_1DOF_95 * scale;
@@ -81,8 +102,13 @@ pub fn profile_intervals_of(
         .filter(|&j| !cov.degenerate[j])
         .flat_map(|j| [(j, 0), (j, 1)])
         .collect();
-    let end =
-        |&(j, s): &(usize, usize)| profile_end(obj, (theta, chi2_min), chi2_min, cov, delta, j, s);
+    let at = Around {
+        chi2_min,
+        cov,
+        delta,
+        inner,
+    };
+    let end = |&(j, s): &(usize, usize)| profile_end(obj, (theta, chi2_min), &at, j, s);
     // Each end is its own profile (warm-started from its own points only), so large data's
     // ends run side by side (a fit's profiles are a fifth of its time, and the last fit of
     // `--model all` otherwise runs its profiles on one core while the other waits) and give
@@ -113,6 +139,16 @@ pub fn profile_intervals_of(
     }))
 }
 
+/// The minimum the profiles are taken around: its chi2, the covariance there, the threshold's
+/// Delta, and the global inner minimisation if any.
+#[derive(Clone, Copy)]
+struct Around<'a> {
+    chi2_min: f64,
+    cov: &'a Covariance,
+    delta: f64,
+    inner: Option<&'a Inner<'a>>,
+}
+
 /// What the profile of one end of one parameter found.
 enum End {
     /// The end, and the inner minimisations that did not converge.
@@ -127,12 +163,16 @@ enum End {
 fn profile_end(
     obj: &impl Residuals,
     from: (&[f64], f64),
-    chi2_min: f64,
-    cov: &Covariance,
-    delta: f64,
+    at: &Around,
     j: usize,
     s: usize,
 ) -> Result<End> {
+    let Around {
+        chi2_min,
+        cov,
+        delta,
+        inner,
+    } = *at;
     let (theta, chi2_from) = from;
     let k = obj.n_params();
     let threshold = chi2_min + delta;
@@ -165,10 +205,23 @@ fn profile_end(
             let mut free = vec![true; k];
             free[j] = false;
             let r = lsq::levenberg_marquardt(obj, &start, &free, &lm)?;
-            if !r.converged {
-                failed_inner.set(failed_inner.get() + 1);
+            // Where the local value is below the threshold so is the profile's (it is at most
+            // that); above it, whether the profile is too must be shown.
+            match inner {
+                Some(global) if !(r.chi2 < threshold) => {
+                    let (th, c, shown) = global(j, t, (&r.theta, r.chi2), threshold)?;
+                    if !shown {
+                        failed_inner.set(failed_inner.get() + 1);
+                    }
+                    (c, th)
+                }
+                _ => {
+                    if !r.converged {
+                        failed_inner.set(failed_inner.get() + 1);
+                    }
+                    (r.chi2, r.theta)
+                }
             }
-            (r.chi2, r.theta)
         };
         if c < beaten && lower_found.borrow().is_none() {
             *lower_found.borrow_mut() = Some(th.clone());
@@ -230,6 +283,7 @@ pub fn extend_to_region(
     cov: &Covariance,
     p: &mut Profiles,
     inside: &[(Vec<f64>, f64)],
+    inner: Option<&Inner>,
 ) -> Result<Extension> {
     let threshold = chi2_min + p.delta;
     let mut moved = Vec::new();
@@ -247,7 +301,13 @@ pub fn extend_to_region(
             else {
                 continue;
             };
-            match profile_end(obj, (th, *c), chi2_min, cov, p.delta, j, s)? {
+            let at = Around {
+                chi2_min,
+                cov,
+                delta: p.delta,
+                inner,
+            };
+            match profile_end(obj, (th, *c), &at, j, s)? {
                 End::Lower(t) => return Ok(Extension::Lower(t)),
                 End::Side(side, failed) => {
                     p.unconverged[j] += failed;
@@ -373,13 +433,19 @@ mod tests {
             Side::At(t) => *t,
             other => panic!("{other:?}"),
         };
-        let intervals =
-            |problem: &TwoValleys| match profile_intervals_of(problem, &[0.0], 0.0, &cov, 1.0)
-                .unwrap()
-            {
-                ProfileOutcome::Done(p) => p,
-                other => panic!("no lower minimum here: {other:?}"),
-            };
+        let intervals = |problem: &TwoValleys| match profile_intervals_of(
+            problem,
+            &[0.0],
+            0.0,
+            &cov,
+            1.0,
+            None,
+        )
+        .unwrap()
+        {
+            ProfileOutcome::Done(p) => p,
+            other => panic!("no lower minimum here: {other:?}"),
+        };
         let problem = TwoValleys {
             lo: [-20.0],
             hi: [20.0],
@@ -397,7 +463,7 @@ mod tests {
             (vec![5.0], 2.0),
         ];
         let Extension::Done(moved) =
-            extend_to_region(&problem, 0.0, &cov, &mut p, &inside).unwrap()
+            extend_to_region(&problem, 0.0, &cov, &mut p, &inside, None).unwrap()
         else {
             panic!("no lower minimum here");
         };
@@ -414,7 +480,7 @@ mod tests {
             hi: [7.0],
         };
         let mut p = intervals(&problem);
-        extend_to_region(&problem, 0.0, &cov, &mut p, &inside).unwrap();
+        extend_to_region(&problem, 0.0, &cov, &mut p, &inside, None).unwrap();
         assert_eq!(p.sides[0][1], Side::Open);
     }
 
@@ -512,7 +578,7 @@ mod tests {
         let mut f0 = vec![0.0; n];
         p.residuals(&[c0, slope], &mut f0).unwrap();
         let cov = lsq::covariance(&lsq::jacobian(&p, &[c0, slope], &[true, true], &f0).unwrap());
-        let out = profile_intervals_of(&p, &[c0, slope], chi2, &cov, 1.0).unwrap();
+        let out = profile_intervals_of(&p, &[c0, slope], chi2, &cov, 1.0, None).unwrap();
         let ProfileOutcome::Done(pr) = out else {
             panic!("{out:?}")
         };
@@ -529,8 +595,8 @@ mod tests {
         // Started two standard errors of c0 from the minimum (chi2 4 above it, for a line
         // exactly), a profile finds a lower point (at one standard error it is 1 above).
         let sd0 = cov.matrix[(0, 0)].sqrt();
-        let off =
-            profile_intervals_of(&p, &[c0 + 2.0 * sd0, slope], chi2 + 4.0, &cov, 1.0).unwrap();
+        let off = profile_intervals_of(&p, &[c0 + 2.0 * sd0, slope], chi2 + 4.0, &cov, 1.0, None)
+            .unwrap();
         assert!(matches!(off, ProfileOutcome::Lower(_)), "{off:?}");
     }
 }

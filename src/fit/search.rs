@@ -50,11 +50,11 @@
 //! switched off ([`super::FitOptions::scan`]).
 
 use super::FitOptions;
-use super::bnb::{Bnb, Candidate, Landscape, Limits, starting_rows};
+use super::bnb::{Bnb, Candidate, CellBox, Landscape, Limits, starting_rows};
 use super::kinks::{KinkStart, axis_stderr, kink_starts, polish_profiles};
 use super::landscape::{PowerLaw, Separable};
 use super::models::{Evaluator, ModelKind};
-use super::objective::Objective;
+use super::objective::{CHI2_1DOF_95, Objective};
 use super::polish::{
     Found, polish_at_bounds, polish_brent, polish_lm, polish_newton, polish_valleys,
 };
@@ -69,7 +69,7 @@ use std::collections::HashMap;
 pub const TAU_REL: f64 = 1e-7;
 pub const TAU_ABS: f64 = 1e-6;
 /// The separable models' starting grid: cells of log eta and of log sigma_y.
-const SEPARABLE_N0: [u64; 2] = [24, 16];
+pub(crate) const SEPARABLE_N0: [u64; 2] = [24, 16];
 /// Local polishes allowed per fit.
 const MAX_POLISH: u64 = 100;
 /// Local minima within this relative distance of the best are finished with line searches
@@ -86,6 +86,18 @@ pub struct SearchOutcome {
     /// Grid nodes with chi2 within 3.84 s of the minimum (full internal coordinates, chi2): for
     /// checking that the 95% region has no part the profile intervals miss.
     pub near_nodes: Vec<(Vec<f64>, f64)>,
+    /// `min` and `product`: the cells of the branch and bound that may hold chi2 within 3.84 s
+    /// of the minimum (no other point of the box does), for the profiles' inner minimisation
+    /// ([`super::slice`]); None for the other models and without the search.
+    pub region: Option<Region>,
+}
+
+/// The part of the box where chi2 may be within 3.84 s of the minimum, as cells of the global
+/// search, and the search's resolution (internal units per axis).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Region {
+    pub cells: Vec<CellBox>,
+    pub resolution: [f64; 2],
 }
 
 /// The tolerance tau for a best value U of the points' chi2 (the rows' chi2 sets the relative
@@ -171,6 +183,7 @@ pub fn global_minimum(obj: &Objective, options: &FitOptions) -> Result<SearchOut
                     .into(),
             ],
             near_nodes: Vec::new(),
+            region: None,
         });
     }
     let ode = matches!(obj.ev.method, VmMethod::Ode(_));
@@ -319,7 +332,17 @@ fn run<L: Landscape>(
         bnb.set_resolution(w);
         fine_width = Some(w);
     }
-    bnb.refine(upper, &tau_of);
+    // For the profiles of `min` and `product`, the cells that may hold chi2 within 3.84 s of
+    // the minimum are kept ([`Region`]).
+    let separable2 = matches!(obj.kind, ModelKind::Min | ModelKind::Product);
+    let keep_of = |u: f64| {
+        if separable2 {
+            u + CHI2_1DOF_95 * obj.scale(u)
+        } else {
+            u
+        }
+    };
+    bnb.refine(upper, &tau_of, &keep_of);
     if let Some((_, _, v)) = bnb.best_node()
         && v < upper
     {
@@ -561,12 +584,16 @@ fn run<L: Landscape>(
              minimum within the tolerance may have been missed"
         ));
     }
-    let scale = obj.scale(best.chi2);
+    let threshold = best.chi2 + CHI2_1DOF_95 * obj.scale(best.chi2);
     let near_nodes = bnb
-        .nodes_below(best.chi2 + super::objective::CHI2_1DOF_95 * scale)
+        .nodes_below(threshold)
         .into_iter()
         .map(|(r, t, v)| (to_theta(&bnb.land, r, t), v))
         .collect();
+    let region = separable2.then(|| Region {
+        cells: bnb.cells_below(threshold),
+        resolution: fine_width.unwrap_or([0.0, 0.0]),
+    });
     Ok(SearchOutcome {
         global: GlobalSearch {
             certified,
@@ -579,5 +606,6 @@ fn run<L: Landscape>(
         best,
         warnings,
         near_nodes,
+        region,
     })
 }

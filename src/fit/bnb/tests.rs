@@ -80,7 +80,7 @@ fn certifies_two_wells_and_proposes_both() {
     // The starting grid (x step 1, y step 0.5) has its nodes at x = -1 and 2: both wells.
     assert!(starts.iter().any(|c| c.t[0] == -1.0) && starts.iter().any(|c| c.t[0] == 2.0));
     // With the true minimum 0 as U, everything is certified within tau.
-    b.refine(0.0, &tau);
+    b.refine(0.0, &tau, &|u| u);
     let c = b.certificate(0.0);
     assert!(
         c.lowest >= -1e-3 && c.lowest <= 0.0 && c.reasons.is_empty() && c.fine_cells == 0,
@@ -99,7 +99,7 @@ fn certifies_two_wells_and_proposes_both() {
     // reported as such with a budget of one cell.
     let land = TwoWells::new(true);
     let mut b = Bnb::new(land, [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], limits);
-    b.refine(0.0, &tau);
+    b.refine(0.0, &tau, &|u| u);
     let c = b.certificate(0.0);
     assert!(c.lowest >= -1e-3 && c.reasons.is_empty(), "{c:?}");
     assert!(b.cells > 1000, "{}", b.cells);
@@ -109,7 +109,7 @@ fn certifies_two_wells_and_proposes_both() {
         max_rows: 10_000,
     };
     let mut b = Bnb::new(land, [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], tight);
-    b.refine(0.0, &tau);
+    b.refine(0.0, &tau, &|u| u);
     let c = b.certificate(0.0);
     assert!(
         c.lowest < -1e-3 && c.reasons.iter().any(|w| w.contains("budget")),
@@ -189,7 +189,7 @@ fn a_row_that_failed_inside_a_starting_block_leaves_its_cells_failed() {
         let i = k / 4;
         assert_eq!(c.failed, i < 2, "cell {k}: {c:?}");
     }
-    b.refine(0.0, &|_| 1e-3);
+    b.refine(0.0, &|_| 1e-3, &|u| u);
     let c = b.certificate(0.0);
     assert!(
         c.reasons.iter().any(|w| w.contains("no model at x = -4")),
@@ -228,7 +228,7 @@ fn points_the_bounds_exclude_are_above_the_target() {
     let mut b = Bnb::new(wells(), [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], limits);
     assert!(b.may_hold_below([-1.0, 0.3], -1.0), "nothing proved yet");
     b.set_resolution([0.05, 0.05]);
-    b.refine(f64::INFINITY, &|_| tau);
+    b.refine(f64::INFINITY, &|_| tau, &|u| u);
     let (_, _, u) = b.best_node().unwrap();
     assert!(b.certificate(u).fine_cells > 0 && u > 0.0, "{u}");
     let target = u - tau;
@@ -249,7 +249,7 @@ fn points_the_bounds_exclude_are_above_the_target() {
         max_rows: 10_000,
     };
     let mut b = Bnb::new(wells(), [(-5.0, 5.0), (-1.0, 1.0)], [10, 4], small);
-    b.refine(f64::INFINITY, &|_| tau);
+    b.refine(f64::INFINITY, &|_| tau, &|u| u);
     let (_, _, u) = b.best_node().unwrap();
     assert!(!b.certificate(u).reasons.is_empty());
     let (excluded, below) = check_exclusions(&b, u - tau);

@@ -79,8 +79,8 @@ pub(super) fn summarise(
                 }
                 if p.unconverged[j] > 0 {
                     warnings.push(format!(
-                        "{}: {} inner minimisations of its profile did not converge; the interval \
-                         may be too short",
+                        "{}: {} inner minimisations of its profile did not converge or were not \
+                         shown global; the interval may be too short",
                         spec.key, p.unconverged[j]
                     ));
                 }
