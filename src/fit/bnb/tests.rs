@@ -258,3 +258,86 @@ fn points_the_bounds_exclude_are_above_the_target() {
         "{excluded} excluded, {below} below"
     );
 }
+
+/// [`Bnb::cells_below`] covers every point below its level: with the loose bounds (cells get
+/// split) and cells kept up to U + 0.7, every point of a 201 x 81 grid over the box with f below
+/// 0.6 lies in a listed cell (the second well, 0.5, among them), and every listed cell's bound
+/// is below 0.6. Dropping nothing above U (`keep_of` = identity) lists no cell around the
+/// second well.
+#[test]
+fn the_cells_below_a_level_cover_every_point_below_it() {
+    let tau = |_: f64| 1e-3;
+    let mut b = Bnb::new(
+        TwoWells::new(true),
+        [(-5.0, 5.0), (-1.0, 1.0)],
+        [10, 4],
+        AMPLE,
+    );
+    b.refine(0.0, &tau, &|u| u + 0.7);
+    let cells = b.cells_below(0.6);
+    let f = |x: f64, y: f64| g(x) + (y - 0.3f64).powi(2);
+    let mut below = 0;
+    for i in 0..=200 {
+        for k in 0..=80 {
+            let (x, y) = (-5.0 + 0.05 * i as f64, -1.0 + 0.025 * k as f64);
+            if f(x, y) >= 0.6 {
+                continue;
+            }
+            below += 1;
+            let covered = cells
+                .iter()
+                .any(|c| c.t0[0] <= x && x <= c.t1[0] && c.t0[1] <= y && y <= c.t1[1]);
+            assert!(covered, "({x}, {y}) f = {} in no cell", f(x, y));
+        }
+    }
+    assert!(below > 100, "{below}");
+    assert!(cells.iter().any(|c| c.t0[0] <= -1.0 && -1.0 <= c.t1[0]));
+    let mut b = Bnb::new(
+        TwoWells::new(true),
+        [(-5.0, 5.0), (-1.0, 1.0)],
+        [10, 4],
+        AMPLE,
+    );
+    b.refine(0.0, &tau, &|u| u);
+    assert!(
+        !b.cells_below(0.6)
+            .iter()
+            .any(|c| c.t0[0] <= -1.0 && -1.0 <= c.t1[0])
+    );
+}
+
+/// [`Bnb::on_cells`] searches only the cells given: from the starting cells around the second
+/// well (x in [-2, 0]), the best node is that well's minimum 0.5 at (-1, 0.3), certified there
+/// to tau, and no node outside the cells is evaluated.
+#[test]
+fn a_search_on_given_cells_stays_in_them() {
+    let tau = |_: f64| 1e-3;
+    // Dyadic positions of the grid Bnb::new would build: 10 cells of x over [-5, 5], 4 of y.
+    let at = |i: u64| i << DEPTH;
+    let cells: Vec<([u64; 2], [u64; 2])> = (3..5)
+        .flat_map(|i| (0..4).map(move |k| ([at(i), at(k)], [at(i + 1), at(k + 1)])))
+        .collect();
+    let mut b = Bnb::on_cells(
+        TwoWells::new(true),
+        [(-5.0, 5.0), (-1.0, 1.0)],
+        [10, 4],
+        &cells,
+        AMPLE,
+    );
+    b.refine(f64::INFINITY, &tau, &|u| u);
+    let (_, t, v) = b.best_node().unwrap();
+    assert!(
+        (v - 0.5).abs() < 1e-3 && (t[0] + 1.0).abs() < 0.05,
+        "{t:?} {v}"
+    );
+    let c = b.certificate(v);
+    assert!(
+        c.lowest >= v - 1e-3 - 1e-12 && c.reasons.is_empty(),
+        "{c:?}"
+    );
+    assert!(
+        b.land.x.iter().all(|&x| (-2.0..=0.0).contains(&x)),
+        "{:?}",
+        b.land.x
+    );
+}
