@@ -482,7 +482,7 @@ fn the_profiles_inner_minimum_is_global_past_the_plateau() {
     let plateau = [t, obj.upper[1]];
     let on_plateau = lsq::chi2(&obj, &plateau).unwrap();
     assert!(on_plateau > threshold, "{on_plateau} {threshold}");
-    let s = slice_minimum(&obj, 0, t, (&plateau, on_plateau), threshold, region).unwrap();
+    let s = slice_minimum(&obj, 0, t, (&plateau, on_plateau, true), threshold, region).unwrap();
     let (scan, y) = scanned_profile(&case, kind, 0, t, (obj.lower[1], obj.upper[1]), 3000);
     assert!(s.certified);
     assert!(s.chi2 < threshold, "{} {threshold}", s.chi2);
@@ -499,7 +499,7 @@ fn the_profiles_inner_minimum_is_global_past_the_plateau() {
         &obj,
         0,
         best.theta[0],
-        (&best.theta, best.chi2),
+        (&best.theta, best.chi2, true),
         threshold,
         region,
     )

@@ -212,6 +212,8 @@ pub struct Bnb<L: Landscape> {
     fine: Vec<Cell>,
     /// Widths below which an axis is not split (internal units; 0 = down to the dyadic grid).
     resolution: [f64; 2],
+    /// A point a local minimisation converged at ([`Bnb::set_polished`]).
+    polished: Option<[f64; 2]>,
     /// Starting grid, for [`Bnb::initial_minima`].
     start_cells: Vec<Cell>,
     pub cells: u64,
@@ -248,6 +250,7 @@ impl<L: Landscape> Bnb<L> {
             kept: Vec::new(),
             fine: Vec::new(),
             resolution: [0.0, 0.0],
+            polished: None,
             start_cells: Vec::new(),
             cells: 0,
             limits,
@@ -315,27 +318,29 @@ impl<L: Landscape> Bnb<L> {
         b
     }
 
-    /// As [`Bnb::new`], but starting from the cells `cells` (dyadic corner positions on the
-    /// grid `new` would build over the same `range` and `n0`) instead of the whole uniform grid:
-    /// the rest of the box is known not to matter (for example a slice of another branch and
-    /// bound's box, [`Bnb::cells_below`]). Not for [`Bnb::initial_minima`], which reads the
-    /// uniform grid.
-    pub fn on_cells(
-        land: L,
-        range: [(f64, f64); 2],
-        n0: [u64; 2],
-        cells: &[([u64; 2], [u64; 2])],
-        limits: Limits,
-    ) -> Self {
-        let mut b = Bnb::empty(land, range, n0, limits);
+    /// A branch and bound over the grid [`Bnb::new`] would build on `range` and `n0`, with no
+    /// cell yet: its starting cells are given by [`Bnb::start_on`] (after
+    /// [`Bnb::set_resolution`] and [`Bnb::set_polished`], which they depend on).
+    pub fn sparse(land: L, range: [(f64, f64); 2], n0: [u64; 2], limits: Limits) -> Self {
+        Bnb::empty(land, range, n0, limits)
+    }
+
+    /// Starts from the cells `cells` (dyadic corner positions) instead of the whole uniform
+    /// grid: the rest of the box is known not to matter (for example a slice of another branch
+    /// and bound's box, [`Bnb::cells_below`]). Their bounds are judged against the lower of the
+    /// best node and `target` (U - tau, where the caller knows a U: an iterative bound stops
+    /// sooner). Not for [`Bnb::initial_minima`], which reads the uniform grid.
+    pub fn start_on(&mut self, cells: &[([u64; 2], [u64; 2])], target: f64) {
         let corners: Vec<[u64; 2]> = cells
             .iter()
             .flat_map(|&(p0, p1)| [p0, [p1[0], p0[1]], [p0[0], p1[1]], p1])
             .collect();
-        b.nodes_at(&corners);
-        b.target = b.best.map_or(f64::INFINITY, |(_, v)| v);
-        b.start_cells = cells.iter().map(|&(p0, p1)| b.make_cell(p0, p1)).collect();
-        b
+        self.nodes_at(&corners);
+        self.target = self.best.map_or(target, |(_, v)| v.min(target));
+        self.start_cells = cells
+            .iter()
+            .map(|&(p0, p1)| self.make_cell(p0, p1))
+            .collect();
     }
 
     /// The starting cells of the block of `size` x `size` cells (fewer at the grid's edges)
@@ -490,7 +495,12 @@ impl<L: Landscape> Bnb<L> {
             .enumerate()
             .all(|(n, &r)| self.axes[n % 2].ok[r]);
         let target = self.target;
-        let mut bound = if ok {
+        let mut bound = if ok && self.around_polished(p0, p1) {
+            Bound {
+                lb: f64::NEG_INFINITY,
+                loose: [1.0, 1.0],
+            }
+        } else if ok {
             self.land.bound(lo, hi, target)
         } else {
             Bound {
@@ -508,6 +518,34 @@ impl<L: Landscape> Bnb<L> {
             bound,
             failed,
         }
+    }
+
+    /// Whether the cell holds the polished point and is wider than the resolution on an active
+    /// axis (closed cells; the slack of [`Bnb::may_hold_below`]).
+    fn around_polished(&self, p0: [u64; 2], p1: [u64; 2]) -> bool {
+        let Some(t) = self.polished else {
+            return false;
+        };
+        let (mut inside, mut coarse) = (true, false);
+        for (k, a) in self.axes.iter().enumerate() {
+            if !a.active {
+                continue;
+            }
+            let (lo, hi) = (a.t_at(p0[k]), a.t_at(p1[k]));
+            let slack = 1e-12 * (a.hi - a.lo).abs();
+            inside &= lo - slack <= t[k] && t[k] <= hi + slack;
+            coarse |= hi - lo > self.resolution[k];
+        }
+        inside && coarse
+    }
+
+    /// A point a local minimisation converged at: the cells holding it are split down to the
+    /// resolution without a bound (near such a point a bound cannot clear a target close to its
+    /// value before the resolution anyway: its cells would be split regardless, and their bounds
+    /// are the work), and left there to that minimisation, as the cells around the minima are
+    /// left to the polishes. For a point whose value is within the tolerance of the target.
+    pub fn set_polished(&mut self, t: [f64; 2]) {
+        self.polished = Some(t);
     }
 
     /// The lowest node evaluated so far: rows, internal coordinates and chi2.

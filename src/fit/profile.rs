@@ -60,12 +60,12 @@ pub enum ProfileOutcome {
     Lower(Vec<f64>),
 }
 
-/// A global inner minimisation: for parameter j held at t, the local minimisation's point and
-/// chi2 there and a target, a point with theta_j = t at least as low, its chi2, and whether it
+/// A global inner minimisation: for parameter j held at t, the local minimisation's point, chi2
+/// and whether it converged there, and a target, a point with theta_j = t at least as low, its chi2, and whether it
 /// is shown that no point with theta_j = t has chi2 below the lower of that chi2 and the target
 /// (by more than the search's tolerance: [`super::slice`]).
 pub type Inner<'a> =
-    dyn Fn(usize, f64, (&[f64], f64), f64) -> Result<(Vec<f64>, f64, bool)> + Sync + 'a;
+    dyn Fn(usize, f64, (&[f64], f64, bool), f64) -> Result<(Vec<f64>, f64, bool)> + Sync + 'a;
 
 /// The global inner minimisation of `obj`'s profiles, where it has one: `min` and `product`,
 /// whose chi2 over one parameter with the other held can have several minima (a plateau where
@@ -209,7 +209,7 @@ fn profile_end(
             // that); above it, whether the profile is too must be shown.
             match inner {
                 Some(global) if !(r.chi2 < threshold) => {
-                    let (th, c, shown) = global(j, t, (&r.theta, r.chi2), threshold)?;
+                    let (th, c, shown) = global(j, t, (&r.theta, r.chi2, r.converged), threshold)?;
                     if !shown {
                         failed_inner.set(failed_inner.get() + 1);
                     }

@@ -306,7 +306,7 @@ fn the_cells_below_a_level_cover_every_point_below_it() {
     );
 }
 
-/// [`Bnb::on_cells`] searches only the cells given: from the starting cells around the second
+/// [`Bnb::start_on`] searches only the cells given: from the starting cells around the second
 /// well (x in [-2, 0]), the best node is that well's minimum 0.5 at (-1, 0.3), certified there
 /// to tau, and no node outside the cells is evaluated.
 #[test]
@@ -317,13 +317,13 @@ fn a_search_on_given_cells_stays_in_them() {
     let cells: Vec<([u64; 2], [u64; 2])> = (3..5)
         .flat_map(|i| (0..4).map(move |k| ([at(i), at(k)], [at(i + 1), at(k + 1)])))
         .collect();
-    let mut b = Bnb::on_cells(
+    let mut b = Bnb::sparse(
         TwoWells::new(true),
         [(-5.0, 5.0), (-1.0, 1.0)],
         [10, 4],
-        &cells,
         AMPLE,
     );
+    b.start_on(&cells, f64::INFINITY);
     b.refine(f64::INFINITY, &tau, &|u| u);
     let (_, t, v) = b.best_node().unwrap();
     assert!(
@@ -340,4 +340,54 @@ fn a_search_on_given_cells_stays_in_them() {
         "{:?}",
         b.land.x
     );
+}
+
+/// [`Bnb::set_polished`]: the cells holding the polished point are split to the resolution
+/// without a bound: every cell left that holds the point is no wider than the resolution (with
+/// the exact bounds here the starting cell [2, 3] x [0, 0.5] is otherwise kept whole: its bound
+/// 0 clears U - tau once a node is within tau of 0). A polished point off the minimum (the
+/// second well, 0.5) costs nothing but its cells: they are dropped by their bounds at the
+/// resolution, and the minimum, 0 at (2, 0.3), is still found and certified.
+#[test]
+fn cells_around_a_polished_point_are_left_at_the_resolution() {
+    let tau = |_: f64| 1e-3;
+    for p in [[2.0, 0.3], [-1.0, 0.3]] {
+        // The whole uniform grid as the starting cells, bounded after set_polished.
+        let at = |i: u64| i << DEPTH;
+        let cells: Vec<([u64; 2], [u64; 2])> = (0..10)
+            .flat_map(|i| (0..4).map(move |k| ([at(i), at(k)], [at(i + 1), at(k + 1)])))
+            .collect();
+        let mut b = Bnb::sparse(
+            TwoWells::new(false),
+            [(-5.0, 5.0), (-1.0, 1.0)],
+            [10, 4],
+            AMPLE,
+        );
+        b.set_resolution([0.1, 0.1]);
+        b.set_polished(p);
+        b.start_on(&cells, f64::INFINITY);
+        b.refine(f64::INFINITY, &tau, &|u| u);
+        let holds = |c: &Cell| {
+            (0..2).all(|k| b.axes[k].t_at(c.p0[k]) <= p[k] && p[k] <= b.axes[k].t_at(c.p1[k]))
+        };
+        let left: Vec<&Cell> = b.fine.iter().chain(&b.done).filter(|c| holds(c)).collect();
+        // At the resolution the cells get their bounds: those around the second well (0.5)
+        // are then dropped, those around the minimum kept.
+        assert_eq!(left.is_empty(), p[0] == -1.0, "{p:?}");
+        for c in left {
+            for k in 0..2 {
+                assert!(
+                    b.axes[k].t_at(c.p1[k]) - b.axes[k].t_at(c.p0[k]) <= 0.1,
+                    "{p:?} {:?} {:?} {:?}",
+                    [0, 1].map(|k| b.axes[k].t_at(c.p0[k])),
+                    [0, 1].map(|k| b.axes[k].t_at(c.p1[k])),
+                    c.bound
+                );
+            }
+        }
+        let (_, t, v) = b.best_node().unwrap();
+        let c = b.certificate(v);
+        assert!(c.reasons.is_empty() && c.lowest >= v - 1e-3, "{c:?}");
+        assert!(v < 0.01 && (t[0] - 2.0).abs() < 0.1, "{t:?} {v}");
+    }
 }
