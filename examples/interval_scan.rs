@@ -24,8 +24,11 @@
 #[path = "fit_global/cases.rs"]
 #[allow(dead_code)]
 mod cases;
+#[path = "fit_global/reference.rs"]
+#[allow(dead_code)]
+mod reference;
 
-use restitution::fit::models::{Evaluator, predict_e};
+use restitution::fit::models::Evaluator;
 use restitution::fit::objective::Objective;
 use restitution::fit::{FitOptions, ModelKind, fit};
 use restitution::models::viscoelastic::VmMethod;
@@ -74,22 +77,7 @@ fn main() {
             let Ok(obj) = Objective::new(&ev, kind) else {
                 continue;
             };
-            let chi2 = |p: [f64; 2]| -> f64 {
-                (0..d.len())
-                    .map(|i| {
-                        let e = predict_e(
-                            kind,
-                            &d.contacts[i],
-                            d.obs[i].v_n_m_s,
-                            &p,
-                            c.rule,
-                            &VmMethod::Master,
-                        )
-                        .unwrap_or(f64::NAN);
-                        ((e - d.obs[i].e) / d.sigma(i)).powi(2)
-                    })
-                    .sum()
-            };
+            let chi2 = |p: [f64; 2]| reference::chi2_direct(d, kind, &p, c.rule);
             let threshold = r.chi2 + r.ci95_delta_chi2;
             for j in 0..2 {
                 let other = 1 - j;

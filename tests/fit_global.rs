@@ -420,26 +420,6 @@ fn randomized_fits_are_at_or_below_an_independent_exhaustive_reference() {
     assert!(failures.is_empty(), "{failures:#?}");
 }
 
-/// chi2 of `kind` at physical parameters `p` on `case`'s data, summed from the model functions
-/// alone (independent of the fit's objective and its sums).
-fn chi2_direct(case: &cases::Case, kind: ModelKind, p: [f64; 2]) -> f64 {
-    let d = &case.data;
-    (0..d.len())
-        .map(|i| {
-            let e = predict_e(
-                kind,
-                &d.contacts[i],
-                d.obs[i].v_n_m_s,
-                &p,
-                case.rule,
-                &VmMethod::Master,
-            )
-            .unwrap_or(f64::NAN);
-            ((e - d.obs[i].e) / d.sigma(i)).powi(2)
-        })
-        .sum()
-}
-
 /// The least chi2 over `m` + 1 log-spaced values of parameter 1 - j across [lo, hi] (internal
 /// coordinates) with parameter j at exp(t): a brute-force profile point, an upper bound of the
 /// true profile that can only find points of the 95% region, never invent them.
@@ -455,7 +435,10 @@ fn scanned_profile(
         .map(|k| {
             let y = lo + (hi - lo) * k as f64 / m as f64;
             let p = if j == 0 { [t, y] } else { [y, t] };
-            (chi2_direct(case, kind, p.map(f64::exp)), y)
+            (
+                reference::chi2_direct(&case.data, kind, &p.map(f64::exp), case.rule),
+                y,
+            )
         })
         .fold((f64::INFINITY, 0.0), |a, b| if b.0 < a.0 { b } else { a })
 }

@@ -13,7 +13,7 @@ use restitution::models::viscoelastic::master::KAPPA_MAX;
 use restitution::models::viscoelastic::{ContactEnd, VmMethod};
 
 /// chi2 of `kind` at physical parameters `p`, point by point through `predict_e`.
-fn chi2_direct(data: &FitData, kind: ModelKind, p: &[f64], rule: ContactEnd) -> f64 {
+pub fn chi2_direct(data: &FitData, kind: ModelKind, p: &[f64], rule: ContactEnd) -> f64 {
     data.obs
         .iter()
         .zip(&data.contacts)

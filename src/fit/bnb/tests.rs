@@ -306,24 +306,32 @@ fn the_cells_below_a_level_cover_every_point_below_it() {
     );
 }
 
+/// A branch and bound over TwoWells' box of [`Bnb::new`]'s tests, with no cell yet.
+fn sparse_two_wells(loose: bool) -> Bnb<TwoWells> {
+    Bnb::sparse(
+        TwoWells::new(loose),
+        [(-5.0, 5.0), (-1.0, 1.0)],
+        [10, 4],
+        AMPLE,
+    )
+}
+
+/// The starting cells of that grid (10 cells of x over [-5, 5], 4 of y) whose x index is in
+/// `xs`, as dyadic positions.
+fn grid_cells(xs: std::ops::Range<u64>) -> Vec<([u64; 2], [u64; 2])> {
+    let at = |i: u64| i << DEPTH;
+    xs.flat_map(|i| (0..4).map(move |k| ([at(i), at(k)], [at(i + 1), at(k + 1)])))
+        .collect()
+}
+
 /// [`Bnb::start_on`] searches only the cells given: from the starting cells around the second
 /// well (x in [-2, 0]), the best node is that well's minimum 0.5 at (-1, 0.3), certified there
 /// to tau, and no node outside the cells is evaluated.
 #[test]
 fn a_search_on_given_cells_stays_in_them() {
     let tau = |_: f64| 1e-3;
-    // Dyadic positions of the grid Bnb::new would build: 10 cells of x over [-5, 5], 4 of y.
-    let at = |i: u64| i << DEPTH;
-    let cells: Vec<([u64; 2], [u64; 2])> = (3..5)
-        .flat_map(|i| (0..4).map(move |k| ([at(i), at(k)], [at(i + 1), at(k + 1)])))
-        .collect();
-    let mut b = Bnb::sparse(
-        TwoWells::new(true),
-        [(-5.0, 5.0), (-1.0, 1.0)],
-        [10, 4],
-        AMPLE,
-    );
-    b.start_on(&cells, f64::INFINITY);
+    let mut b = sparse_two_wells(true);
+    b.start_on(&grid_cells(3..5), f64::INFINITY);
     b.refine(f64::INFINITY, &tau, &|u| u);
     let (_, t, v) = b.best_node().unwrap();
     assert!(
@@ -353,19 +361,10 @@ fn cells_around_a_polished_point_are_left_at_the_resolution() {
     let tau = |_: f64| 1e-3;
     for p in [[2.0, 0.3], [-1.0, 0.3]] {
         // The whole uniform grid as the starting cells, bounded after set_polished.
-        let at = |i: u64| i << DEPTH;
-        let cells: Vec<([u64; 2], [u64; 2])> = (0..10)
-            .flat_map(|i| (0..4).map(move |k| ([at(i), at(k)], [at(i + 1), at(k + 1)])))
-            .collect();
-        let mut b = Bnb::sparse(
-            TwoWells::new(false),
-            [(-5.0, 5.0), (-1.0, 1.0)],
-            [10, 4],
-            AMPLE,
-        );
+        let mut b = sparse_two_wells(false);
         b.set_resolution([0.1, 0.1]);
         b.set_polished(p);
-        b.start_on(&cells, f64::INFINITY);
+        b.start_on(&grid_cells(0..10), f64::INFINITY);
         b.refine(f64::INFINITY, &tau, &|u| u);
         let holds = |c: &Cell| {
             (0..2).all(|k| b.axes[k].t_at(c.p0[k]) <= p[k] && p[k] <= b.axes[k].t_at(c.p1[k]))
