@@ -92,20 +92,12 @@ fn main() {
             let Ok(obj) = Objective::new(&ev, kind) else {
                 continue;
             };
-            let chi2 = |p: [f64; 2]| reference::chi2_direct(d, kind, &p, c.rule);
             let threshold = r.chi2 + r.ci95_delta_chi2;
             for j in 0..2 {
                 let other = 1 - j;
                 let (olo, ohi) = (obj.lower[other], obj.upper[other]);
-                let profile = |t: f64| -> (f64, f64) {
-                    let m = 3000;
-                    (0..=m)
-                        .map(|k| {
-                            let y = olo + (ohi - olo) * k as f64 / m as f64;
-                            let p = if j == 0 { [t, y] } else { [y, t] };
-                            (chi2(p.map(f64::exp)), y)
-                        })
-                        .fold((f64::INFINITY, 0.0), |a, b| if b.0 < a.0 { b } else { a })
+                let profile = |t: f64| {
+                    reference::separable_profile(d, kind, c.rule, (j, t), (olo, ohi), 3000)
                 };
                 let best = r.theta[j];
                 for (s, end) in [(0, r.params[j].ci95.0), (1, r.params[j].ci95.1)] {
@@ -184,8 +176,6 @@ fn count_moved(from: u64, to: u64) {
 
 /// The `--powerlaw` scan (see the module doc).
 fn scan_powerlaw(from: u64, to: u64) {
-    use restitution::fit::models::powerlaw_d_mm;
-    use restitution::fit::scalar::brent_minimize;
     let kind = ModelKind::PowerLaw;
     let (mut fits, mut ends, mut short, mut unresolved) = (0, 0, 0, 0);
     for seed in from..to {
@@ -203,50 +193,9 @@ fn scan_powerlaw(from: u64, to: u64) {
         let Ok(obj) = Objective::new(&ev, kind) else {
             continue;
         };
-        let chi2 = |p: [f64; 3]| reference::chi2_direct(d, kind, &p, c.rule);
-        let (a_lo, a_hi) = (obj.lower[0].exp(), obj.upper[0].exp());
-        // A at its weighted least-squares value for the exponents (a, b), kept in its box.
-        let best_a = |a: f64, b: f64| -> f64 {
-            let (mut sxy, mut sxx) = (0.0, 0.0);
-            for i in 0..d.len() {
-                let x = (powerlaw_d_mm(&d.contacts[i]) / 10.0).powf(-a) * d.obs[i].v_n_m_s.powf(b);
-                let w = d.sigma(i).powi(-2);
-                sxy += w * x * (1.0 - d.obs[i].e);
-                sxx += w * x * x;
-            }
-            (sxy / sxx).clamp(a_lo, a_hi)
-        };
-        let axis = |k: usize, m: usize| -> Vec<f64> {
-            (0..=m)
-                .map(|i| obj.lower[k] + (obj.upper[k] - obj.lower[k]) * i as f64 / m as f64)
-                .collect()
-        };
-        // Brent's method on f within one grid step either side of x (kept in [lo, hi]): the
-        // grid finds the basin, this its bottom (both only ever find points of chi2 the model
-        // functions give, never invent them).
-        let refine = |f: &dyn Fn(f64) -> f64, x: f64, step: f64, lo: f64, hi: f64| -> (f64, f64) {
-            let (a, b) = ((x - step).max(lo), (x + step).min(hi));
-            match brent_minimize(|y| Ok(f(y)), a, b, 1e-12) {
-                Ok(m) if m.fx < f(x) => (m.x, m.fx),
-                _ => (x, f(x)),
-            }
-        };
-        // The least over one exponent (index k) of f, by a grid of m steps and Brent.
-        let least_over = |k: usize, m: usize, f: &dyn Fn(f64) -> f64| -> (f64, f64) {
-            let xs = axis(k, m);
-            let (x, _) = xs
-                .iter()
-                .map(|&x| (x, f(x)))
-                .fold((xs[0], f64::INFINITY), |a, b| if b.1 < a.1 { b } else { a });
-            let step = (obj.upper[k] - obj.lower[k]) / m as f64;
-            refine(f, x, step, obj.lower[k], obj.upper[k])
-        };
         // The brute-force profile of exponent j (1 or 2) at internal coordinate t.
-        let profile = |j: usize, t: f64| -> f64 {
-            match j {
-                1 => least_over(2, 1500, &|b| chi2([best_a(t, b), t, b])).1,
-                _ => least_over(1, 1500, &|a| chi2([best_a(a, t), a, t])).1,
-            }
+        let profile = |j: usize, t: f64| {
+            reference::powerlaw_profile(d, c.rule, (j, t), &obj.lower, &obj.upper)
         };
         let threshold = r.chi2 + r.ci95_delta_chi2;
         for j in 1..3 {

@@ -25,6 +25,76 @@ pub fn chi2_direct(data: &FitData, kind: ModelKind, p: &[f64], rule: ContactEnd)
         .sum()
 }
 
+/// A brute-force profile point of `min` or `product`: the least chi2 over `m` + 1 log-spaced
+/// values of parameter 1 - j across [lo, hi] (internal coordinates) with parameter j at exp(t),
+/// and where. An upper bound of the true profile: it can only find points of the 95% region,
+/// never invent them.
+#[allow(dead_code)] // for examples/interval_scan.rs and tests/fit_global.rs
+pub fn separable_profile(
+    data: &FitData,
+    kind: ModelKind,
+    rule: ContactEnd,
+    (j, t): (usize, f64),
+    (lo, hi): (f64, f64),
+    m: usize,
+) -> (f64, f64) {
+    (0..=m)
+        .map(|k| {
+            let y = lo + (hi - lo) * k as f64 / m as f64;
+            let p = if j == 0 { [t, y] } else { [y, t] };
+            (chi2_direct(data, kind, &p.map(f64::exp), rule), y)
+        })
+        .fold((f64::INFINITY, 0.0), |a, b| if b.0 < a.0 { b } else { a })
+}
+
+/// A brute-force profile point of the power law's exponent j (1: a, 2: b) at t: the least chi2
+/// over 1500 values of the other exponent across its box (`lower`, `upper`: the fit's box in
+/// internal coordinates, ln A first) then Brent's method within a grid step of the best, each
+/// with A at its weighted least-squares value (1 - e is linear in A; kept in A's box, where chi2
+/// is a parabola in A); chi2 from the model functions. An upper bound of the true profile, as
+/// [`separable_profile`].
+#[allow(dead_code)] // for examples/interval_scan.rs and tests/fit_global.rs
+pub fn powerlaw_profile(
+    data: &FitData,
+    rule: ContactEnd,
+    (j, t): (usize, f64),
+    lower: &[f64],
+    upper: &[f64],
+) -> f64 {
+    let kind = ModelKind::PowerLaw;
+    let (a_lo, a_hi) = (lower[0].exp(), upper[0].exp());
+    let best_a = |a: f64, b: f64| -> f64 {
+        let (mut sxy, mut sxx) = (0.0, 0.0);
+        for (i, (o, c)) in data.obs.iter().zip(&data.contacts).enumerate() {
+            let x = (powerlaw_d_mm(c) / POWERLAW_D_REF_MM).powf(-a)
+                * (o.v_n_m_s / POWERLAW_V_REF_M_S).powf(b);
+            let w = data.sigma(i).powi(-2);
+            sxy += w * x * (1.0 - o.e);
+            sxx += w * x * x;
+        }
+        (sxy / sxx).clamp(a_lo, a_hi)
+    };
+    let k = 3 - j;
+    let chi2 = |x: f64| {
+        let (a, b) = if j == 1 { (t, x) } else { (x, t) };
+        chi2_direct(data, kind, &[best_a(a, b), a, b], rule)
+    };
+    let m = 1500;
+    let step = (upper[k] - lower[k]) / m as f64;
+    let (x, v) = (0..=m)
+        .map(|i| lower[k] + step * i as f64)
+        .map(|x| (x, chi2(x)))
+        .fold(
+            (lower[k], f64::INFINITY),
+            |a, b| if b.1 < a.1 { b } else { a },
+        );
+    let (lo, hi) = ((x - step).max(lower[k]), (x + step).min(upper[k]));
+    match restitution::fit::scalar::brent_minimize(|y| Ok(chi2(y)), lo, hi, 1e-12) {
+        Ok(r) if r.fx < v => r.fx,
+        _ => v,
+    }
+}
+
 /// The search box of `kind` as the fit documents it, recomputed from the contact functions.
 fn reference_box(data: &FitData, kind: ModelKind) -> Vec<(f64, f64)> {
     let pts = || data.obs.iter().zip(&data.contacts);

@@ -61,26 +61,35 @@ pub enum ProfileOutcome {
 }
 
 /// A global inner minimisation: for parameter j held at t, the local minimisation's point, chi2
-/// and whether it converged there, and a target, a point with theta_j = t at least as low, its chi2, and whether it
-/// is shown that no point with theta_j = t has chi2 below the lower of that chi2 and the target
-/// (by more than the search's tolerance: [`super::slice`]).
-pub type Inner<'a> =
-    dyn Fn(usize, f64, (&[f64], f64, bool), f64) -> Result<(Vec<f64>, f64, bool)> + Sync + 'a;
+/// and whether it converged there, and a target, a point with theta_j = t at least as low, its
+/// chi2, and whether it is shown that no point with theta_j = t has chi2 below the lower of that
+/// chi2 and the target (by more than the search's tolerance: [`super::slice`]); None for a
+/// parameter it does not cover (the local minimisation's result stands).
+pub type Inner<'a> = dyn Fn(usize, f64, (&[f64], f64, bool), f64) -> Result<Option<(Vec<f64>, f64, bool)>>
+    + Sync
+    + 'a;
 
 /// The global inner minimisation of `obj`'s profiles, where it has one: `min` and `product`,
 /// whose chi2 over one parameter with the other held can have several minima (a plateau where
-/// every point stays elastic, the kinks of `min`), with the global search's `region`.
+/// every point stays elastic, the kinks of `min`), and the power law's exponents (whose local
+/// minimisation over A and the other exponent put 5 of 336 ends short on the randomized test's
+/// seeds 0-100: `examples/interval_scan --powerlaw`), with the global search's `region`.
 pub fn global_inner<'a>(
     obj: &'a Objective<'a>,
     region: Option<&'a Region>,
 ) -> Option<Box<Inner<'a>>> {
     let region = region?;
-    if !matches!(obj.kind, ModelKind::Min | ModelKind::Product) {
+    if !matches!(
+        obj.kind,
+        ModelKind::Min | ModelKind::Product | ModelKind::PowerLaw
+    ) {
         return None;
     }
     Some(Box::new(move |j, t, local, target| {
-        let m = slice_minimum(obj, j, t, local, target, region)?;
-        Ok((m.theta, m.chi2, m.certified))
+        Ok(
+            slice_minimum(obj, j, t, local, target, region)?
+                .map(|m| (m.theta, m.chi2, m.certified)),
+        )
     }))
 }
 
@@ -207,15 +216,20 @@ fn profile_end(
             let r = lsq::levenberg_marquardt(obj, &start, &free, &lm)?;
             // Where the local value is below the threshold so is the profile's (it is at most
             // that); above it, whether the profile is too must be shown.
-            match inner {
-                Some(global) if !(r.chi2 < threshold) => {
-                    let (th, c, shown) = global(j, t, (&r.theta, r.chi2, r.converged), threshold)?;
+            let global = match inner {
+                Some(g) if !(r.chi2 < threshold) => {
+                    g(j, t, (&r.theta, r.chi2, r.converged), threshold)?
+                }
+                _ => None,
+            };
+            match global {
+                Some((th, c, shown)) => {
                     if !shown {
                         failed_inner.set(failed_inner.get() + 1);
                     }
                     (c, th)
                 }
-                _ => {
+                None => {
                     if !r.converged {
                         failed_inner.set(failed_inner.get() + 1);
                     }

@@ -70,6 +70,8 @@ pub const TAU_REL: f64 = 1e-7;
 pub const TAU_ABS: f64 = 1e-6;
 /// The separable models' starting grid: cells of log eta and of log sigma_y.
 pub(crate) const SEPARABLE_N0: [u64; 2] = [24, 16];
+/// The power law's starting grid: cells of its exponents (a, b).
+pub(crate) const POWERLAW_N0: [u64; 2] = [10, 10];
 /// Local polishes allowed per fit.
 const MAX_POLISH: u64 = 100;
 /// Local minima within this relative distance of the best are finished with line searches
@@ -86,9 +88,9 @@ pub struct SearchOutcome {
     /// Grid nodes with chi2 within 3.84 s of the minimum (full internal coordinates, chi2): for
     /// checking that the 95% region has no part the profile intervals miss.
     pub near_nodes: Vec<(Vec<f64>, f64)>,
-    /// `min` and `product`: the cells of the branch and bound that may hold chi2 within 3.84 s
-    /// of the minimum (no other point of the box does), for the profiles' inner minimisation
-    /// ([`super::slice`]); None for the other models and without the search.
+    /// `min`, `product` and the power law: the cells of the branch and bound that may hold chi2
+    /// within 3.84 s of the minimum (no other point of the box does), for the profiles' inner
+    /// minimisation ([`super::slice`]); None for the other models and without the search.
     pub region: Option<Region>,
 }
 
@@ -222,7 +224,7 @@ pub fn global_minimum(obj: &Objective, options: &FitOptions) -> Result<SearchOut
             let mut land = PowerLaw::new(obj);
             land.bound_tol = 0.1 * TAU_ABS;
             let range = [(obj.lower[1], obj.upper[1]), (obj.lower[2], obj.upper[2])];
-            let bnb = Bnb::new(land, range, [10, 10], limits);
+            let bnb = Bnb::new(land, range, POWERLAW_N0, limits);
             let to_theta =
                 |land: &PowerLaw, r: [usize; 2], t: [f64; 2]| vec![land.profile(r).0, t[0], t[1]];
             // The profile over the exponents first, then all three parameters from there; the
@@ -332,11 +334,14 @@ fn run<L: Landscape>(
         bnb.set_resolution(w);
         fine_width = Some(w);
     }
-    // For the profiles of `min` and `product`, the cells that may hold chi2 within 3.84 s of
-    // the minimum are kept ([`Region`]).
-    let separable2 = matches!(obj.kind, ModelKind::Min | ModelKind::Product);
+    // For the profiles of the two-parameter models and the power law, the cells that may hold
+    // chi2 within 3.84 s of the minimum are kept ([`Region`]).
+    let keeps_region = matches!(
+        obj.kind,
+        ModelKind::Min | ModelKind::Product | ModelKind::PowerLaw
+    );
     let keep_of = |u: f64| {
-        if separable2 {
+        if keeps_region {
             u + CHI2_1DOF_95 * obj.scale(u)
         } else {
             u
@@ -602,7 +607,7 @@ fn run<L: Landscape>(
         .into_iter()
         .map(|(r, t, v)| (to_theta(&bnb.land, r, t), v))
         .collect();
-    let region = separable2.then(|| Region {
+    let region = keeps_region.then(|| Region {
         cells: bnb.cells_below(threshold),
         resolution: fine_width.unwrap_or([0.0, 0.0]),
     });
