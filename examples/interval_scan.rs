@@ -38,10 +38,7 @@ mod cases;
 #[allow(dead_code)]
 mod reference;
 
-use restitution::fit::models::Evaluator;
-use restitution::fit::objective::Objective;
-use restitution::fit::{FitOptions, ModelKind, fit};
-use restitution::models::viscoelastic::VmMethod;
+use restitution::fit::{FitOptions, ModelKind};
 
 fn main() {
     let mut args: Vec<String> = std::env::args().skip(1).collect();
@@ -80,22 +77,14 @@ fn main() {
         let c = cases::make_case(seed);
         let d = &c.data;
         for kind in [ModelKind::Min, ModelKind::Product] {
-            let options = FitOptions {
-                rule: c.rule,
-                ..FitOptions::default()
-            };
-            let Ok(r) = fit(d, kind, &options) else {
+            let Some((r, lower, upper)) = reference::fit_with_box(&c, kind) else {
                 continue;
             };
             fits += 1;
-            let ev = Evaluator::new(d, c.rule, VmMethod::Master);
-            let Ok(obj) = Objective::new(&ev, kind) else {
-                continue;
-            };
             let threshold = r.chi2 + r.ci95_delta_chi2;
             for j in 0..2 {
                 let other = 1 - j;
-                let (olo, ohi) = (obj.lower[other], obj.upper[other]);
+                let (olo, ohi) = (lower[other], upper[other]);
                 let profile = |t: f64| {
                     reference::separable_profile(d, kind, c.rule, (j, t), (olo, ohi), 3000)
                 };
@@ -109,7 +98,7 @@ fn main() {
                     let beyond = std::iter::once(0.001)
                         .chain((1..=30).map(|k| 2.0 * k as f64 / 30.0))
                         .map(|f| end + dir * w * f)
-                        .filter(|t| *t >= obj.lower[j] && *t <= obj.upper[j]);
+                        .filter(|t| *t >= lower[j] && *t <= upper[j]);
                     let found = beyond
                         .map(|t| (t, profile(t)))
                         .filter(|(_, (v, _))| *v < threshold)
@@ -181,22 +170,13 @@ fn scan_powerlaw(from: u64, to: u64) {
     for seed in from..to {
         let c = cases::make_case(seed);
         let d = &c.data;
-        let options = FitOptions {
-            rule: c.rule,
-            ..FitOptions::default()
-        };
-        let Ok(r) = fit(d, kind, &options) else {
+        let Some((r, lower, upper)) = reference::fit_with_box(&c, kind) else {
             continue;
         };
         fits += 1;
-        let ev = Evaluator::new(d, c.rule, VmMethod::Master);
-        let Ok(obj) = Objective::new(&ev, kind) else {
-            continue;
-        };
         // The brute-force profile of exponent j (1 or 2) at internal coordinate t.
-        let profile = |j: usize, t: f64| {
-            reference::powerlaw_profile(d, c.rule, (j, t), &obj.lower, &obj.upper)
-        };
+        let profile =
+            |j: usize, t: f64| reference::powerlaw_profile(d, c.rule, (j, t), &lower, &upper);
         let threshold = r.chi2 + r.ci95_delta_chi2;
         for j in 1..3 {
             // The scan must find the fit's own minimum at the fit's value (1e-6 relative: the
@@ -223,7 +203,7 @@ fn scan_powerlaw(from: u64, to: u64) {
                 let found = std::iter::once(0.001)
                     .chain((1..=12).map(|k| k as f64 / 6.0))
                     .map(|f| end + dir * w * f)
-                    .filter(|t| *t >= obj.lower[j] && *t <= obj.upper[j])
+                    .filter(|t| *t >= lower[j] && *t <= upper[j])
                     .map(|t| (t, profile(j, t)))
                     .filter(|(_, v)| *v < threshold)
                     .max_by(|a, b| ((a.0 - b.0) * dir).total_cmp(&0.0));

@@ -487,6 +487,35 @@ fn the_profiles_inner_minimum_is_global_past_the_plateau() {
     assert_eq!((s.chi2, &s.theta), (best.chi2, &best.theta));
 }
 
+/// Probes beyond each end of parameter j's 95% interval of `r`: at 0.001, 0.003 and 0.01 of
+/// the end's distance w from the estimate (where the short ends were) and at 0.2 w to 2 w,
+/// inside the box (internal coordinates, `log`: the parameter fitted as a log); (side, t).
+fn probes_beyond(
+    r: &restitution::fit::FitResult,
+    j: usize,
+    log: bool,
+    (lower, upper): (&[f64], &[f64]),
+) -> Vec<(usize, f64)> {
+    let mut out = Vec::new();
+    for (s, end) in [(0, r.params[j].ci95.0), (1, r.params[j].ci95.1)] {
+        let Some(end) = end else { continue };
+        let end = if log { end.ln() } else { end };
+        let dir = if s == 0 { -1.0 } else { 1.0 };
+        // (theta: internal coordinates.)
+        let w = (end - r.theta[j]).abs().max(1e-4);
+        for f in [0.001, 0.003, 0.01]
+            .into_iter()
+            .chain((1..=10).map(|k| k as f64 / 5.0))
+        {
+            let t = end + dir * w * f;
+            if lower[j] <= t && t <= upper[j] {
+                out.push((s, t));
+            }
+        }
+    }
+    out
+}
+
 /// The ends of `min`'s and `product`'s 95% intervals bound the region: beyond each end (13
 /// probes out to twice its distance w from the estimate, three of them within 0.01 w, where the
 /// short ends were), a brute-force profile (3000 log points of the other parameter across the
@@ -495,8 +524,6 @@ fn the_profiles_inner_minimum_is_global_past_the_plateau() {
 /// 7e-5, 1.3e-3 and 2.7e-4 relative).
 #[test]
 fn interval_ends_are_not_short_of_the_95_percent_region() {
-    use restitution::fit::models::Evaluator;
-    use restitution::fit::objective::Objective;
     let mut short = Vec::new();
     for (seed, kind) in [
         (4, ModelKind::Min),
@@ -504,42 +531,22 @@ fn interval_ends_are_not_short_of_the_95_percent_region() {
         (11, ModelKind::Min),
     ] {
         let case = cases::make_case(seed);
-        let options = FitOptions {
-            rule: case.rule,
-            ..FitOptions::default()
-        };
-        let r = fit(&case.data, kind, &options).unwrap();
+        let (r, lower, upper) = reference::fit_with_box(&case, kind).unwrap();
         assert!(r.converged && r.global.certified, "{:?}", r.warnings);
-        let ev = Evaluator::new(&case.data, case.rule, VmMethod::Master);
-        let obj = Objective::new(&ev, kind).unwrap();
         let threshold = r.chi2 + r.ci95_delta_chi2;
         for j in 0..2 {
             let o = 1 - j;
-            for (s, end) in [(0, r.params[j].ci95.0), (1, r.params[j].ci95.1)] {
-                let Some(end) = end else { continue };
-                let end = end.ln();
-                let dir = if s == 0 { -1.0 } else { 1.0 };
-                // (theta: internal coordinates, the logarithms.)
-                let w = (end - r.theta[j]).abs().max(1e-4);
-                for f in [0.001, 0.003, 0.01]
-                    .into_iter()
-                    .chain((1..=10).map(|k| k as f64 / 5.0))
-                {
-                    let t = end + dir * w * f;
-                    if t < obj.lower[j] || t > obj.upper[j] {
-                        continue;
-                    }
-                    let (v, _) = reference::separable_profile(
-                        &case.data,
-                        kind,
-                        case.rule,
-                        (j, t),
-                        (obj.lower[o], obj.upper[o]),
-                        3000,
-                    );
-                    if v < threshold {
-                        short.push(format!("seed {seed} {kind} param {j} end {s}: {v} at {t}"));
-                    }
+            for (s, t) in probes_beyond(&r, j, true, (&lower, &upper)) {
+                let (v, _) = reference::separable_profile(
+                    &case.data,
+                    kind,
+                    case.rule,
+                    (j, t),
+                    (lower[o], upper[o]),
+                    3000,
+                );
+                if v < threshold {
+                    short.push(format!("seed {seed} {kind} param {j} end {s}: {v} at {t}"));
                 }
             }
         }
@@ -556,23 +563,15 @@ fn interval_ends_are_not_short_of_the_95_percent_region() {
 /// fit's own minimum at the fit's value (1e-6 relative).
 #[test]
 fn power_law_exponent_ends_are_not_short_of_the_95_percent_region() {
-    use restitution::fit::models::Evaluator;
-    use restitution::fit::objective::Objective;
     let kind = ModelKind::PowerLaw;
     let mut short = Vec::new();
     for seed in [5, 9, 54, 80] {
         let case = cases::make_case(seed);
-        let options = FitOptions {
-            rule: case.rule,
-            ..FitOptions::default()
-        };
-        let r = fit(&case.data, kind, &options).unwrap();
+        let (r, lower, upper) = reference::fit_with_box(&case, kind).unwrap();
         assert!(r.converged && r.global.certified, "{:?}", r.warnings);
-        let ev = Evaluator::new(&case.data, case.rule, VmMethod::Master);
-        let obj = Objective::new(&ev, kind).unwrap();
         let threshold = r.chi2 + r.ci95_delta_chi2;
         let profile = |j: usize, t: f64| {
-            reference::powerlaw_profile(&case.data, case.rule, (j, t), &obj.lower, &obj.upper)
+            reference::powerlaw_profile(&case.data, case.rule, (j, t), &lower, &upper)
         };
         for j in 1..3 {
             let at_min = profile(j, r.theta[j]);
@@ -581,23 +580,10 @@ fn power_law_exponent_ends_are_not_short_of_the_95_percent_region() {
                 "seed {seed} {j}: {at_min} {}",
                 r.chi2
             );
-            for (s, end) in [(0, r.params[j].ci95.0), (1, r.params[j].ci95.1)] {
-                // (The exponents' internal coordinates are the exponents themselves.)
-                let Some(end) = end else { continue };
-                let dir = if s == 0 { -1.0 } else { 1.0 };
-                let w = (end - r.theta[j]).abs().max(1e-4);
-                for f in [0.001, 0.003, 0.01]
-                    .into_iter()
-                    .chain((1..=10).map(|k| k as f64 / 5.0))
-                {
-                    let t = end + dir * w * f;
-                    if t < obj.lower[j] || t > obj.upper[j] {
-                        continue;
-                    }
-                    let v = profile(j, t);
-                    if v < threshold {
-                        short.push(format!("seed {seed} param {j} end {s}: {v} at {t}"));
-                    }
+            for (s, t) in probes_beyond(&r, j, false, (&lower, &upper)) {
+                let v = profile(j, t);
+                if v < threshold {
+                    short.push(format!("seed {seed} param {j} end {s}: {v} at {t}"));
                 }
             }
         }

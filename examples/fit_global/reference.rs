@@ -25,6 +25,23 @@ pub fn chi2_direct(data: &FitData, kind: ModelKind, p: &[f64], rule: ContactEnd)
         .sum()
 }
 
+/// `case`'s fit by `kind` (with its contact rule) and the fit's search box in internal
+/// coordinates (lower, upper), for checking its intervals; None where either fails.
+#[allow(dead_code)] // for examples/interval_scan.rs and tests/fit_global.rs
+pub fn fit_with_box(
+    case: &Case,
+    kind: ModelKind,
+) -> Option<(restitution::fit::FitResult, Vec<f64>, Vec<f64>)> {
+    let options = FitOptions {
+        rule: case.rule,
+        ..FitOptions::default()
+    };
+    let r = fit(&case.data, kind, &options).ok()?;
+    let ev = restitution::fit::models::Evaluator::new(&case.data, case.rule, VmMethod::Master);
+    let obj = restitution::fit::objective::Objective::new(&ev, kind).ok()?;
+    Some((r, obj.lower.clone(), obj.upper.clone()))
+}
+
 /// A brute-force profile point of `min` or `product`: the least chi2 over `m` + 1 log-spaced
 /// values of parameter 1 - j across [lo, hi] (internal coordinates) with parameter j at exp(t),
 /// and where. An upper bound of the true profile: it can only find points of the 95% region,
