@@ -12,9 +12,9 @@
 //! then the crossing by Brent's root finder ([`super::scalar::profile_crossing`]). The inner
 //! minimisation is Levenberg-Marquardt warm-started from the nearest profile point already
 //! computed, so a profile follows its valley; where its value is at or above the threshold, an
-//! [`Inner`] given (the fit's, for `min` and `product`: [`super::slice`]) shows it is the
-//! profile's or finds a lower point (a value below the threshold needs no check: the profile is
-//! at most that). [`extend_to_region`] then moves an end past any known point of the 95% region
+//! [`Inner`] given (the fit's, for `min`, `product` and the power law's exponents:
+//! [`super::slice`]) shows it is the profile's or finds a lower point (a value below the
+//! threshold needs no check: the profile is at most that). [`extend_to_region`] then moves an end past any known point of the 95% region
 //! beyond it (the interval is the hull of the region found). A profile point below the minimum
 //! reveals a lower minimum: the caller refits from it. Every failure is a value: a side whose crossing could
 //! not be found is [`Side::Lost`] with the reason, and inner minimisations that did not converge
@@ -24,7 +24,6 @@
 //! the least-squares value +- sqrt(3.84) standard errors.
 
 use super::lsq::{self, Covariance, LmOptions, Residuals};
-use super::models::ModelKind;
 use super::objective::{CHI2_1DOF_95, Objective};
 use super::scalar::{Crossing, profile_crossing};
 use super::search::Region;
@@ -78,13 +77,9 @@ pub fn global_inner<'a>(
     obj: &'a Objective<'a>,
     region: Option<&'a Region>,
 ) -> Option<Box<Inner<'a>>> {
+    // The search keeps a region for exactly these models; a parameter the slices do not cover
+    // gets None from slice_minimum.
     let region = region?;
-    if !matches!(
-        obj.kind,
-        ModelKind::Min | ModelKind::Product | ModelKind::PowerLaw
-    ) {
-        return None;
-    }
     Some(Box::new(move |j, t, local, target| {
         Ok(
             slice_minimum(obj, j, t, local, target, region)?
