@@ -8,6 +8,7 @@ use restitution::contact::Contact;
 use restitution::fit::models::{
     ModelKind, POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S, e_pm, e_vm, powerlaw_d_mm, predict_e,
 };
+use restitution::fit::scalar::brent_minimize;
 use restitution::fit::{FitData, FitOptions, fit};
 use restitution::models::viscoelastic::master::KAPPA_MAX;
 use restitution::models::viscoelastic::{ContactEnd, VmMethod};
@@ -110,6 +111,179 @@ pub fn powerlaw_profile(
         Ok(r) if r.fx < v => r.fx,
         _ => v,
     }
+}
+
+/// A brute-force profile point of the power law's coefficient A at ln A = `ln_a`: the least
+/// chi2 over both exponents (a, b) in their box (`lower`, `upper`: the fit's box in internal
+/// coordinates, ln A first), with A held. [`powerlaw_a_profile_at`] gives the exponents too.
+///
+/// With A held nothing is linear, and the valley of (a, b) can be narrow and oblique (the
+/// points' ln(d/d_ref) and ln(v/v_ref) nearly collinear), where rounds of one-exponent searches
+/// creep: so a 120 x 120 grid over the box, then from each of the 5 lowest grid-local minima a
+/// damped Newton polish (Levenberg-Marquardt steps on the exact gradient and Hessian of chi2 in
+/// (a, b), the Gauss-Newton Hessian where the exact one is not positive definite, each step
+/// projected into the box and kept only where it lowers chi2) alternating with Brent's method
+/// along a and along b within a grid step (for a minimum on an edge of the box), until a round
+/// lowers chi2 by less than 1e-12 relative. Independent of the fit: nothing of its search,
+/// polish or profile is used, only the model functions: the grid and the derivatives are
+/// written out here from 1 - e = A (d/d_ref)^(-a) (v/v_ref)^b, and every value compared or
+/// returned is [`chi2_direct`]. An upper bound of the true profile, as [`separable_profile`]:
+/// it can only find points of the 95% region, never invent them.
+#[allow(dead_code)] // for examples/interval_scan.rs
+pub fn powerlaw_a_profile(
+    data: &FitData,
+    rule: ContactEnd,
+    ln_a: f64,
+    lower: &[f64],
+    upper: &[f64],
+) -> f64 {
+    powerlaw_a_profile_at(data, rule, ln_a, lower, upper).0
+}
+
+/// [`powerlaw_a_profile`] and where: (chi2, a, b).
+#[allow(dead_code)] // for examples/interval_scan.rs
+pub fn powerlaw_a_profile_at(
+    data: &FitData,
+    rule: ContactEnd,
+    ln_a: f64,
+    lower: &[f64],
+    upper: &[f64],
+) -> (f64, f64, f64) {
+    let kind = ModelKind::PowerLaw;
+    let a_coef = ln_a.exp();
+    // Per point: ln(d/d_ref), ln(v/v_ref), 1 - e, weight.
+    let pts: Vec<(f64, f64, f64, f64)> = data
+        .obs
+        .iter()
+        .zip(&data.contacts)
+        .enumerate()
+        .map(|(i, (o, c))| {
+            (
+                (powerlaw_d_mm(c) / POWERLAW_D_REF_MM).ln(),
+                (o.v_n_m_s / POWERLAW_V_REF_M_S).ln(),
+                1.0 - o.e,
+                data.sigma(i).powi(-2),
+            )
+        })
+        .collect();
+    let chi2 = |a: f64, b: f64| {
+        let v = chi2_direct(data, kind, &[a_coef, a, b], rule);
+        if v.is_nan() { f64::INFINITY } else { v }
+    };
+    let (a_box, b_box) = ((lower[1], upper[1]), (lower[2], upper[2]));
+    let clamp = |a: f64, b: f64| (a.clamp(a_box.0, a_box.1), b.clamp(b_box.0, b_box.1));
+
+    // The grid, from the formula: A exp(-a x1) exp(b x2) with both factors tabulated.
+    let n = 120;
+    let (ga, gb) = (axis(a_box.0, a_box.1, n), axis(b_box.0, b_box.1, n));
+    let (step_a, step_b) = (ga[1] - ga[0], gb[1] - gb[0]);
+    let ea: Vec<Vec<f64>> = ga
+        .iter()
+        .map(|&a| pts.iter().map(|p| a_coef * (-a * p.0).exp()).collect())
+        .collect();
+    let eb: Vec<Vec<f64>> = gb
+        .iter()
+        .map(|&b| pts.iter().map(|p| (b * p.1).exp()).collect())
+        .collect();
+    let mut values = Vec::with_capacity(n * n);
+    for ra in &ea {
+        for rb in &eb {
+            let v: f64 = pts
+                .iter()
+                .zip(ra.iter().zip(rb))
+                .map(|(p, (x, y))| p.3 * (p.2 - x * y).powi(2))
+                .sum();
+            values.push(if v.is_finite() { v } else { f64::INFINITY });
+        }
+    }
+    let mut minima = grid_minima(&values, &[n, n]);
+    minima.sort_by(|&i, &j| values[i].total_cmp(&values[j]));
+
+    // Gradient and Hessian of chi2 in (a, b): with m = A exp(-a x1 + b x2) and r = y - m,
+    // dm/da = -x1 m, dm/db = x2 m; H = 2 sum w (dm dm^T - r d2m). Also the Gauss-Newton part.
+    let derivs = |a: f64, b: f64| {
+        let (mut g, mut h, mut hgn) = ([0.0; 2], [0.0; 3], [0.0; 3]);
+        for &(x1, x2, y, w) in &pts {
+            let m = a_coef * (-a * x1 + b * x2).exp();
+            let r = y - m;
+            let (da, db) = (-x1 * m, x2 * m);
+            g[0] -= 2.0 * w * r * da;
+            g[1] -= 2.0 * w * r * db;
+            let gn = [da * da, da * db, db * db];
+            let second = [x1 * x1 * m, -x1 * x2 * m, x2 * x2 * m];
+            for k in 0..3 {
+                hgn[k] += 2.0 * w * gn[k];
+                h[k] += 2.0 * w * (gn[k] - r * second[k]);
+            }
+        }
+        (g, h, hgn)
+    };
+    let pos_def = |h: &[f64; 3]| h[0] > 0.0 && h[2] > 0.0 && h[0] * h[2] - h[1] * h[1] > 0.0;
+    // Levenberg-Marquardt from (a, b) at chi2 f, each step projected into the box.
+    let newton = |(mut a, mut b, mut f): (f64, f64, f64)| {
+        let mut lambda = 1e-3;
+        for _ in 0..500 {
+            let (g, h, hgn) = derivs(a, b);
+            let h = if pos_def(&h) { h } else { hgn };
+            let d = [h[0].abs().max(1e-300), h[2].abs().max(1e-300)];
+            let mut moved = None;
+            while lambda < 1e20 {
+                let k = [h[0] + lambda * d[0], h[1], h[2] + lambda * d[1]];
+                let det = k[0] * k[2] - k[1] * k[1];
+                if pos_def(&k) && det.is_finite() {
+                    let sa = -(k[2] * g[0] - k[1] * g[1]) / det;
+                    let sb = -(k[0] * g[1] - k[1] * g[0]) / det;
+                    let (qa, qb) = clamp(a + sa, b + sb);
+                    let fq = chi2(qa, qb);
+                    if fq < f {
+                        moved = Some((qa, qb, fq));
+                        lambda = (lambda / 4.0).max(1e-12);
+                        break;
+                    }
+                }
+                lambda *= 4.0;
+            }
+            let Some((qa, qb, fq)) = moved else { break };
+            let gain = f - fq;
+            (a, b, f) = (qa, qb, fq);
+            if gain <= 1e-13 * f {
+                break;
+            }
+        }
+        (a, b, f)
+    };
+    // Brent's method along a, then along b, within a grid step of the point.
+    let sweep = |(mut a, mut b, mut f): (f64, f64, f64)| {
+        let (lo, hi) = ((a - step_a).max(a_box.0), (a + step_a).min(a_box.1));
+        if let Ok(r) = brent_minimize(|x| Ok(chi2(x, b)), lo, hi, 1e-12)
+            && r.fx < f
+        {
+            (a, f) = (r.x, r.fx);
+        }
+        let (lo, hi) = ((b - step_b).max(b_box.0), (b + step_b).min(b_box.1));
+        if let Ok(r) = brent_minimize(|x| Ok(chi2(a, x)), lo, hi, 1e-12)
+            && r.fx < f
+        {
+            (b, f) = (r.x, r.fx);
+        }
+        (a, b, f)
+    };
+    let mut best = (f64::NAN, f64::NAN, f64::INFINITY);
+    for &idx in minima.iter().take(5) {
+        let (a, b) = (ga[idx / n], gb[idx % n]);
+        let mut p = (a, b, chi2(a, b));
+        for _ in 0..50 {
+            let before = p.2;
+            p = sweep(newton(p));
+            if !(before - p.2 > 1e-12 * p.2) {
+                break;
+            }
+        }
+        if p.2 < best.2 {
+            best = p;
+        }
+    }
+    (best.2, best.0, best.1)
 }
 
 /// The search box of `kind` as the fit documents it, recomputed from the contact functions.

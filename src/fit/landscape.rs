@@ -124,6 +124,17 @@ mod tests {
     }
 
     fn check_bounds_on(d: &FitData, kind: ModelKind, cells: &[([f64; 2], [f64; 2])]) {
+        check_bounds_held(d, kind, cells, None);
+    }
+
+    /// [`check_bounds_on`], for the power law with ln A held at `held` where given
+    /// ([`PowerLaw::hold_amplitude`]: chi2 at that A, not its minimum over A).
+    fn check_bounds_held(
+        d: &FitData,
+        kind: ModelKind,
+        cells: &[([f64; 2], [f64; 2])],
+        held: Option<f64>,
+    ) {
         let ev = Evaluator::new(d, ContactEnd::Overlap, VmMethod::Master);
         let obj = Objective::new(&ev, kind).unwrap();
         for &(lo, hi) in cells {
@@ -134,7 +145,9 @@ mod tests {
                     ModelKind::Min | ModelKind::Product => vec![t[0], t[1]],
                     ModelKind::PowerLaw => {
                         vec![
-                            super::super::powerlaw::ProfiledPowerLaw::new(&obj).ln_a(&t),
+                            held.unwrap_or_else(|| {
+                                super::super::powerlaw::ProfiledPowerLaw::new(&obj).ln_a(&t)
+                            }),
                             t[0],
                             t[1],
                         ]
@@ -144,6 +157,9 @@ mod tests {
             };
             let bound = if kind == ModelKind::PowerLaw {
                 let mut l = PowerLaw::new(&obj);
+                if let Some(ln_a) = held {
+                    l.hold_amplitude(ln_a);
+                }
                 for k in 0..2 {
                     l.add_row(k, lo[k]).unwrap();
                     l.add_row(k, hi[k]).unwrap();
@@ -157,6 +173,17 @@ mod tests {
                 let at = |l: &PowerLaw, t: f64| l.bound([0, 0], [1, 1], t).lb;
                 let mut b = at(&l, f64::NEG_INFINITY).max(at(&l, f64::INFINITY));
                 let corners = [[0, 0], [1, 0], [0, 1], [1, 1]].map(|r| l.node(r));
+                if held.is_some() {
+                    // With A held a node is chi2 at that A (1e-12 relative: the same sums in
+                    // other orders).
+                    for (r, v) in [[0, 0], [1, 0], [0, 1], [1, 1]].iter().zip(corners) {
+                        let want = direct([[lo, hi][r[0]][0], [lo, hi][r[1]][1]]);
+                        assert!(
+                            (v - want).abs() <= 1e-12 * want.max(1.0),
+                            "{r:?}: {v} vs {want}"
+                        );
+                    }
+                }
                 let corner = corners.iter().cloned().fold(f64::INFINITY, f64::min);
                 for t in [
                     f64::NEG_INFINITY,
@@ -277,6 +304,23 @@ mod tests {
         ];
         cells.extend(powerlaw_cells(&[1e-6, 1e-3, 0.02, 0.1, 0.3, 0.7, 2.0]));
         check_bounds(ModelKind::PowerLaw, &cells);
+    }
+
+    #[test]
+    fn power_law_bounds_with_a_held_are_below_chi2_at_that_a() {
+        // The landscape of A's profile ([`crate::fit::slice`]): its nodes are chi2 at the A held
+        // and its bounds lie below chi2 at that A over each cell, with A at, below and above
+        // the data's best A (ln A about -2.2 on the pattern) and far from it; small and large
+        // data.
+        let base = data();
+        let large = distinct(&base, crate::fit::sums::PARALLEL_MIN_POINTS + 1000);
+        let mut cells = vec![([0.3, 0.1], [0.7, 0.5]), ([-3.0, 2.0], [1.0, 4.0])];
+        cells.extend(powerlaw_cells(&[1e-5, 0.01, 0.2, 1.0]));
+        for d in [&base, &large] {
+            for ln_a in [-2.2, -2.5, -1.9, -8.0, 1.0] {
+                check_bounds_held(d, ModelKind::PowerLaw, &cells, Some(ln_a));
+            }
+        }
     }
 
     #[test]

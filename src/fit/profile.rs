@@ -12,7 +12,7 @@
 //! then the crossing by Brent's root finder ([`super::scalar::profile_crossing`]). The inner
 //! minimisation is Levenberg-Marquardt warm-started from the nearest profile point already
 //! computed, so a profile follows its valley; where its value is at or above the threshold, an
-//! [`Inner`] given (the fit's, for `min`, `product` and the power law's exponents:
+//! [`Inner`] given (the fit's, for `min`, `product` and the power law:
 //! [`super::slice`]) shows it is the profile's or finds a lower point (a value below the
 //! threshold needs no check: the profile is at most that). [`extend_to_region`] then moves an end past any known point of the 95% region
 //! beyond it (the interval is the hull of the region found). A profile point below the minimum
@@ -70,15 +70,14 @@ pub type Inner<'a> = dyn Fn(usize, f64, (&[f64], f64, bool), f64) -> Result<Opti
 
 /// The global inner minimisation of `obj`'s profiles, where it has one: `min` and `product`,
 /// whose chi2 over one parameter with the other held can have several minima (a plateau where
-/// every point stays elastic, the kinks of `min`), and the power law's exponents (whose local
-/// minimisation over A and the other exponent put 5 of 336 ends short on the randomized test's
-/// seeds 0-100: `examples/interval_scan --powerlaw`), with the global search's `region`.
+/// every point stays elastic, the kinks of `min`), and the power law (whose local minimisation
+/// put 5 of 336 ends of its exponents and 1 of 144 of A short on the randomized test's seeds
+/// 0-100: `examples/interval_scan --powerlaw`), with the global search's `region`.
 pub fn global_inner<'a>(
     obj: &'a Objective<'a>,
     region: Option<&'a Region>,
 ) -> Option<Box<Inner<'a>>> {
-    // The search keeps a region for exactly these models; a parameter the slices do not cover
-    // gets None from slice_minimum.
+    // The search keeps a region for exactly these models.
     let region = region?;
     Some(Box::new(move |j, t, local, target| {
         Ok(

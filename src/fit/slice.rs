@@ -1,12 +1,12 @@
-//! The global minimum of chi2 over one parameter with another held, for `min` and `product`
-//! (either parameter) and the power law (an exponent, A at its least-squares value): the inner
-//! minimisation of their profile intervals ([`super::profile`]).
+//! The global minimum of chi2 over the other parameters with one held, for `min` and `product`
+//! (either parameter) and the power law (an exponent, A at its least-squares value; or A, both
+//! exponents free): the inner minimisation of their profile intervals ([`super::profile`]).
 //!
 //! **Solves** min over x in its search box of chi2(theta) with theta_j = t, x the other
-//! parameter (for the power law, the other exponent with A profiled out), and establishes, for
-//! the value U it reports, that no x outside small cells around the minima has chi2 below
-//! U - tau (tau of [`super::search::tolerance`]), and that every local minimum of the grid
-//! inside those cells that could beat U was polished.
+//! parameter (for the power law's exponents, the other exponent with A profiled out; for its A,
+//! both exponents), and establishes, for the value U it reports, that no x outside small cells
+//! around the minima has chi2 below U - tau (tau of [`super::search::tolerance`]), and that
+//! every local minimum of the grid inside those cells that could beat U was polished.
 //!
 //! **Why it is needed**: the profile's Levenberg-Marquardt is local, and chi2 along x need not
 //! have one minimum. With eta held, chi2 over sigma_y ends in a plateau where every point stays
@@ -15,24 +15,28 @@
 //! (`product`) then put the upper end of eta's interval at 22.971 where chi2 is below the
 //! threshold at 23.001. The kinks of `min` can hold a second minimum the same way. For the
 //! power law, Levenberg-Marquardt over A and the other exponent lost its valley near an end:
-//! seed 80's upper end of a was 0.25998 where chi2 is 27.7 below the threshold at 0.26017.
+//! seed 80's upper end of a was 0.25998 where chi2 is 27.7 below the threshold at 0.26017. With
+//! A held, nothing shows that the exponents have one minimum either.
 //!
 //! **Method**: the global search's own ([`super::search`]) on a slice of its box: branch and
-//! bound ([`super::bnb`]) over x alone, the held parameter an axis of one row, with the cell
-//! bounds of the model's landscape ([`super::landscape`]), on the global search's cells that
-//! could hold chi2 below the target (the rest of the box is shown above it), from the local
-//! minimum's value as U; then Brent's method from every grid-local minimum in a cell whose
-//! bound could beat U. The rows of x's grid are the same at every t of a profile (the same box,
-//! the same dyadic grid), so the evaluator computes each once per fit.
+//! bound ([`super::bnb`]) with the cell bounds of the model's landscape ([`super::landscape`]),
+//! on the global search's cells that could hold chi2 below the target (the rest of the box is
+//! shown above it), from the local minimum's value as U; then a local polish from every
+//! grid-local minimum in a cell whose bound could beat U. For one free parameter the held one
+//! is an axis of one row and the polish is Brent's method; the rows of x's grid are the same at
+//! every t of a profile (the same box, the same dyadic grid), so the evaluator computes each
+//! once per fit. For the power law's A the landscape is that of the exponents with A's range
+//! the one value held (its bounds minimise over A's range: they bound chi2 at that A), and the
+//! polish is Levenberg-Marquardt over the exponents.
 //!
 //! **Known answer** (`tests/fit_global.rs`, `the_profiles_inner_minimum_is_global_past_the_plateau`:
 //! the data sets live with the randomized test): the slice where the local minimisation stopped
 //! on the plateau (the seed above) gets the minimum a 3000-point scan finds, and a slice with one
 //! minimum keeps the local one. The intervals it gives are checked against brute-force profiles
 //! in the same file (`interval_ends_are_not_short_of_the_95_percent_region`,
-//! `power_law_exponent_ends_are_not_short_of_the_95_percent_region`).
+//! `power_law_ends_are_not_short_of_the_95_percent_region`).
 
-use super::bnb::{Bnb, Landscape, Limits};
+use super::bnb::{Bnb, Candidate, Landscape, Limits};
 use super::landscape::{PowerLaw, Separable};
 use super::lsq;
 use super::models::ModelKind;
@@ -57,12 +61,12 @@ pub struct SliceMinimum {
     pub certified: bool,
 }
 
-/// The minimum over the other parameter with theta_j = t (see the module doc), for `min` and
-/// `product` (either parameter) and the power law (an exponent, j = 1 or 2; A at its
-/// least-squares value), as far as it matters below `target`: `local` is the local
+/// The minimum over the other parameters with theta_j = t (see the module doc), for `min` and
+/// `product` (either parameter) and the power law (an exponent, j = 1 or 2, A at its
+/// least-squares value; or A, j = 0), as far as it matters below `target`: `local` is the local
 /// minimisation's point, chi2 (kept when nothing beats it) and whether it converged, `region`
 /// the global search's cells that may hold chi2 below `target` (at least: every other point of
-/// the box is shown above it). None for a parameter it does not cover (the power law's A).
+/// the box is shown above it). None for the models without a region (`vm`, `pm`).
 pub fn slice_minimum(
     obj: &Objective,
     j: usize,
@@ -118,9 +122,22 @@ pub fn slice_minimum(
                 .on(land, [h, o], box_, POWERLAW_N0, o + 1, &at, &chi2)
                 .map(Some)
         }
+        ModelKind::PowerLaw => {
+            // A held: the landscape of the exponents with A's range the one value (its bounds
+            // and nodes minimise over A's range: over that value alone).
+            let mut land = PowerLaw::new(obj);
+            land.bound_tol = 0.1 * TAU_ABS;
+            land.hold_amplitude(t);
+            let box_ = [(obj.lower[1], obj.upper[1]), (obj.lower[2], obj.upper[2])];
+            slice.held_amplitude(land, box_).map(Some)
+        }
         _ => Ok(None),
     }
 }
+
+/// A local polish from a candidate of a slice's branch and bound: the full parameters and chi2
+/// where it ended, None where it does not start.
+type Polish<'a> = dyn Fn(&Candidate) -> Result<Option<(Vec<f64>, f64)>> + 'a;
 
 /// What a slice is taken at and judged against (see [`slice_minimum`]).
 struct Slice<'a> {
@@ -216,6 +233,88 @@ impl Slice<'_> {
             bnb.set_polished(p);
         }
         bnb.start_on(&cells, u0 - tau_of(u0));
+        // Brent's method on the bracket, not where the local minimisation already polished (as
+        // the search: a polished point inside the bracket); 1e-10 in the internal coordinate, as
+        // the one-parameter polishes: far below any standard error.
+        let polish = |c: &Candidate| -> Result<Option<(Vec<f64>, f64)>> {
+            let (lo, hi) = (c.bracket_lo[o], c.bracket_hi[o]);
+            if !(lo < hi) || (lo <= x_local && x_local <= hi) {
+                return Ok(None);
+            }
+            let m = scalar::brent_minimize(chi2, lo, hi, 1e-10)?;
+            Ok(Some((at(m.x), m.fx)))
+        };
+        self.search(bnb, best, &|tt| at(tt[o]), &polish)
+    }
+
+    /// The power law with A held at t (parameter 0): a branch and bound over both exponents on
+    /// the global search's cells that could hold chi2 below the target (with A free over its
+    /// range, so with A = t too), its grid-local minima polished by Levenberg-Marquardt over
+    /// the exponents.
+    fn held_amplitude(&self, land: PowerLaw, box_: [(f64, f64); 2]) -> Result<SliceMinimum> {
+        let Slice {
+            obj,
+            t,
+            local,
+            target,
+            region,
+            limits,
+        } = *self;
+        let mut best = (local.0.to_vec(), local.1);
+        if best.1.is_nan() {
+            best.1 = f64::INFINITY;
+        }
+        if region.cells.is_empty() {
+            return Ok(SliceMinimum {
+                theta: best.0,
+                chi2: best.1,
+                certified: true,
+            });
+        }
+        let cells: Vec<([u64; 2], [u64; 2])> = region.cells.iter().map(|c| (c.p0, c.p1)).collect();
+        let mut bnb = Bnb::sparse(land, box_, POWERLAW_N0, limits);
+        // The search's resolution (1/4096 of the box without one).
+        let resolution = [0, 1].map(|k| {
+            if region.resolution[k] > 0.0 {
+                region.resolution[k]
+            } else {
+                (box_[k].1 - box_[k].0) / 4096.0
+            }
+        });
+        bnb.set_resolution(resolution);
+        let tau_of = |u: f64| tolerance(obj, u);
+        let ab_local = [1, 2].map(|k| local.0.get(k).copied().unwrap_or(f64::NAN));
+        let u0 = best.1.min(target);
+        if local.2 && ab_local.iter().all(|x| x.is_finite()) && best.1 <= u0 + tau_of(u0) {
+            bnb.set_polished(ab_local);
+        }
+        bnb.start_on(&cells, u0 - tau_of(u0));
+        let lm = lsq::LmOptions::default();
+        let polish = |c: &Candidate| -> Result<Option<(Vec<f64>, f64)>> {
+            let inside =
+                (0..2).all(|k| c.bracket_lo[k] <= ab_local[k] && ab_local[k] <= c.bracket_hi[k]);
+            if inside {
+                return Ok(None);
+            }
+            let r = lsq::levenberg_marquardt(obj, &[t, c.t[0], c.t[1]], &[false, true, true], &lm)?;
+            Ok(Some((r.theta, r.chi2)))
+        };
+        self.search(bnb, best, &|tt| vec![t, tt[0], tt[1]], &polish)
+    }
+
+    /// The slice's branch and bound from its starting cells, with `best` (the local
+    /// minimisation's point and chi2) as the first U: rounds of refinement and of polishes
+    /// (`polish`, None where it does not start) from the grid-local minima whose cells could
+    /// beat U; `at_node` maps a node's coordinates to the full parameters.
+    fn search<L: Landscape>(
+        &self,
+        mut bnb: Bnb<L>,
+        mut best: (Vec<f64>, f64),
+        at_node: &dyn Fn([f64; 2]) -> Vec<f64>,
+        polish: &Polish,
+    ) -> Result<SliceMinimum> {
+        let (obj, target) = (self.obj, self.target);
+        let tau_of = |u: f64| tolerance(obj, u);
         // A polish that lowers U leaves cells set aside against the old U - tau: refined again
         // against the new one (a few rounds; the certificate below says whether they sufficed).
         for _ in 0..ROUNDS {
@@ -224,21 +323,17 @@ impl Slice<'_> {
             if let Some((_, tt, v)) = bnb.best_node()
                 && v < best.1
             {
-                best = (at(tt[o]), v);
+                best = (at_node(tt), v);
             }
             let u = best.1.min(target);
             for c in bnb.candidates(u) {
-                let (lo, hi) = (c.bracket_lo[o], c.bracket_hi[o]);
-                // Not where the local minimisation already polished (as the search: a polished
-                // point inside the bracket).
-                if c.lb >= u - tau_of(u) || !(lo < hi) || (lo <= x_local && x_local <= hi) {
+                if c.lb >= u - tau_of(u) {
                     continue;
                 }
-                // 1e-10 in the internal coordinate, as the one-parameter polishes: far below
-                // any standard error.
-                let m = scalar::brent_minimize(chi2, lo, hi, 1e-10)?;
-                if m.fx < best.1 {
-                    best = (at(m.x), m.fx);
+                if let Some((th, fx)) = polish(&c)?
+                    && fx < best.1
+                {
+                    best = (th, fx);
                 }
             }
             if !(best.1 < before) {
