@@ -510,17 +510,27 @@ impl<'a> Evaluator<'a> {
     /// both compute it (the same values; the first stored is kept), and none waits on another's
     /// computation (a rayon task waiting there could be the one that has to finish it).
     pub fn row(&self, axis: usize, t: f64) -> Arc<Vec<f64>> {
-        let key = (axis, t.to_bits());
+        self.memo_row((axis, t.to_bits()), || {
+            let mut row = vec![0.0; self.len()];
+            if axis == 1 {
+                self.e_pm_row(t.exp(), &mut row);
+            } else {
+                self.e_vm_row(t.exp(), &mut row);
+            }
+            row
+        })
+    }
+
+    /// The row kept under `key` (an axis and the bits of its t), made by `make` the first time
+    /// it is asked for (see [`Evaluator::row`], whose axes are 0 and 1; the power law's
+    /// landscape keeps its rows of exp(-a x1) and exp(b x2) under 2 and 3: its searches over
+    /// the exponents and every slice of its profiles share the grid's rows).
+    pub fn memo_row(&self, key: (usize, u64), make: impl FnOnce() -> Vec<f64>) -> Arc<Vec<f64>> {
         let memo = || self.rows.0.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(row) = memo().get(&key) {
             return Arc::clone(row);
         }
-        let mut row = vec![0.0; self.len()];
-        if axis == 1 {
-            self.e_pm_row(t.exp(), &mut row);
-        } else {
-            self.e_vm_row(t.exp(), &mut row);
-        }
+        let row = make();
         Arc::clone(memo().entry(key).or_insert(Arc::new(row)))
     }
 

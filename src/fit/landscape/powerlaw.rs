@@ -2,13 +2,14 @@
 //! bound is in the parent module's documentation, its tests beside the separable models' there.
 
 use super::super::bnb::{Bound, Landscape};
-use super::super::models::{POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S, powerlaw_d_mm};
+use super::super::models::{Evaluator, POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S, powerlaw_d_mm};
 use super::super::objective::{Objective, chi2_rounding};
 use super::super::{sums, vexp};
 use lanes::{load, store};
 use rayon::prelude::*;
 use std::cell::RefCell;
 use std::collections::HashMap;
+use std::sync::Arc;
 use wide::{CmpGt, f64x4};
 
 mod first_order;
@@ -29,7 +30,9 @@ const NARROW_M: f64 = 1.0;
 const WIDE_M: f64 = 4.0;
 
 /// The power law's landscape over (a, b), A profiled out.
-pub struct PowerLaw {
+pub struct PowerLaw<'a> {
+    /// The evaluator whose memo keeps the rows ([`Evaluator::memo_row`]).
+    ev: &'a Evaluator<'a>,
     n: usize,
     y: Vec<f64>,
     w: Vec<f64>,
@@ -42,8 +45,10 @@ pub struct PowerLaw {
     m2: f64,
     a_range: (f64, f64),
     /// Rows exp(-a c1_i) (axis 0) and exp(b c2_i) (axis 1), with their t (each row its own
-    /// allocation: one growing array was copied, and faulted in again, as it grew).
-    rows: [Vec<Vec<f64>>; 2],
+    /// allocation: one growing array was copied, and faulted in again, as it grew), shared
+    /// through the evaluator with every landscape of the same fit's power law (a slice of a
+    /// profile starts on the search's cells: 19 rows each on 100 000 points, the same each time).
+    rows: [Vec<Arc<Vec<f64>>>; 2],
     /// Each row's largest value (the scale of [`PowerLaw::profile`]'s sums).
     row_max: [Vec<f64>; 2],
     t: [Vec<f64>; 2],
@@ -67,8 +72,8 @@ pub struct PowerLaw {
     e_accuracy: f64,
 }
 
-impl PowerLaw {
-    pub fn new(obj: &Objective) -> Self {
+impl<'a> PowerLaw<'a> {
+    pub fn new(obj: &Objective<'a>) -> Self {
         let data = obj.ev.data;
         let n = data.len();
         let x1: Vec<f64> = data
@@ -87,6 +92,7 @@ impl PowerLaw {
         let wy2 = (0..n).map(|i| w[i] * (1.0 - data.obs[i].e).powi(2)).sum();
         let wmax = w.iter().cloned().fold(0.0, f64::max);
         PowerLaw {
+            ev: obj.ev,
             n,
             y: data.obs.iter().map(|o| 1.0 - o.e).collect(),
             w_scaled: w.iter().map(|x| x / wmax).collect(),
@@ -197,23 +203,27 @@ impl PowerLaw {
     }
 }
 
-impl Landscape for PowerLaw {
+impl Landscape for PowerLaw<'_> {
     fn add_row(&mut self, axis: usize, t: f64) -> Result<(), String> {
         let c = if axis == 0 { &self.c1 } else { &self.c2 };
         let sign = if axis == 0 { -1.0 } else { 1.0 };
-        let mut row = vec![0.0; self.n];
-        if sums::is_large(self.n) {
-            // Four exps at a time ([`vexp`], within an ulp of the C library's, as the model's
-            // own evaluations on large data): the scalar exp was a third of the slices' time.
-            sums::fill_chunks(&mut row, |start, o| {
-                for (k, z) in o.iter_mut().enumerate() {
-                    *z = sign * t * c[start + k];
-                }
-                vexp::exp_in_place(o);
-            });
-        } else {
-            sums::fill(&mut row, |i| (sign * t * c[i]).exp());
-        }
+        let row = self.ev.memo_row((2 + axis, t.to_bits()), || {
+            let mut row = vec![0.0; self.n];
+            if sums::is_large(self.n) {
+                // Four exps at a time ([`vexp`], within an ulp of the C library's, as the
+                // model's own evaluations on large data): the scalar exp was a third of the
+                // slices' time.
+                sums::fill_chunks(&mut row, |start, o| {
+                    for (k, z) in o.iter_mut().enumerate() {
+                        *z = sign * t * c[start + k];
+                    }
+                    vexp::exp_in_place(o);
+                });
+            } else {
+                sums::fill(&mut row, |i| (sign * t * c[i]).exp());
+            }
+            row
+        });
         let (bad, max) = row.iter().fold((false, 0.0), |(bad, max), &z| {
             (bad || !z.is_finite(), if z > max { z } else { max })
         });
@@ -321,7 +331,7 @@ impl Landscape for PowerLaw {
     }
 }
 
-impl PowerLaw {
+impl PowerLaw<'_> {
     /// The first-order bound as a cell's bound takes it: [`PowerLaw::bound_from_inside`] for
     /// large data, [`PowerLaw::first_order`] for small, lowered by the rounding allowance of two
     /// computations of one chi2 ([`chi2_rounding`]). f is formed as chi2 is, so where the cell's

@@ -7,7 +7,7 @@ use super::lanes::{self, load};
 use super::{POWERLAW_BOUND_ITERS, PowerLaw};
 use wide::{CmpGt, f64x4};
 
-impl PowerLaw {
+impl PowerLaw<'_> {
     /// f(A), f'(A) and f''(A) (from the right) of the module doc. Four points at a time,
     /// branch-free ([`super::lanes`]); every input is finite (rows are checked when they are
     /// made).
