@@ -149,7 +149,35 @@ struct Slice<'a> {
     limits: Limits,
 }
 
+/// The local minimisation's point and chi2 where the global search's region does not reach the
+/// slice: no point of it has chi2 below the target.
+fn nothing_below(best: (Vec<f64>, f64)) -> SliceMinimum {
+    SliceMinimum {
+        theta: best.0,
+        chi2: best.1,
+        certified: true,
+    }
+}
+
+/// The global search's resolution on axis k of `box_` (1/4096 of the box without one).
+fn resolution_of(region: &Region, box_: [(f64, f64); 2], k: usize) -> f64 {
+    if region.resolution[k] > 0.0 {
+        region.resolution[k]
+    } else {
+        (box_[k].1 - box_[k].0) / 4096.0
+    }
+}
+
 impl Slice<'_> {
+    /// The local minimisation's point and chi2 (NaN as +inf): the slice's first U.
+    fn local_best(&self) -> (Vec<f64>, f64) {
+        let (theta, chi2, _) = self.local;
+        (
+            theta.to_vec(),
+            if chi2.is_nan() { f64::INFINITY } else { chi2 },
+        )
+    }
+
     /// The slice on landscape `land` over the box `box_` with starting cells `n0`: `axes` the
     /// held axis and the other, `x_at` the index in theta of the other's parameter, `at(x)` the
     /// full parameters at x and `chi2(x)` chi2 there.
@@ -173,10 +201,7 @@ impl Slice<'_> {
             limits,
         } = *self;
         let [h, o] = axes;
-        let mut best = (local.0.to_vec(), local.1);
-        if best.1.is_nan() {
-            best.1 = f64::INFINITY;
-        }
+        let best = self.local_best();
         // The search's cells the slice crosses (cells are closed: one on either side of t when
         // t is on their shared edge; a relative slack of 1e-12 of the box covers the rounding of
         // the corners' coordinates), as intervals of the other axis: dyadic, so any two are
@@ -191,11 +216,7 @@ impl Slice<'_> {
         spans.sort_by_key(|&(a, b)| (a, std::cmp::Reverse(b)));
         spans.dedup_by(|inner, outer| inner.1 <= outer.1);
         if spans.is_empty() {
-            return Ok(SliceMinimum {
-                theta: best.0,
-                chi2: best.1,
-                certified: true,
-            });
+            return Ok(nothing_below(best));
         }
         let mut range = box_;
         range[h] = (t, t);
@@ -211,13 +232,8 @@ impl Slice<'_> {
             })
             .collect();
         let mut bnb = Bnb::sparse(land, range, n0, limits);
-        // The search's resolution (1/4096 of the box without one).
         let mut resolution = [0.0; 2];
-        resolution[o] = if region.resolution[o] > 0.0 {
-            region.resolution[o]
-        } else {
-            (box_[o].1 - box_[o].0) / 4096.0
-        };
+        resolution[o] = resolution_of(region, box_, o);
         bnb.set_resolution(resolution);
         let tau_of = |u: f64| tolerance(obj, u);
         let x_local = local.0.get(x_at).copied().unwrap_or(f64::NAN);
@@ -260,28 +276,13 @@ impl Slice<'_> {
             region,
             limits,
         } = *self;
-        let mut best = (local.0.to_vec(), local.1);
-        if best.1.is_nan() {
-            best.1 = f64::INFINITY;
-        }
+        let best = self.local_best();
         if region.cells.is_empty() {
-            return Ok(SliceMinimum {
-                theta: best.0,
-                chi2: best.1,
-                certified: true,
-            });
+            return Ok(nothing_below(best));
         }
         let cells: Vec<([u64; 2], [u64; 2])> = region.cells.iter().map(|c| (c.p0, c.p1)).collect();
         let mut bnb = Bnb::sparse(land, box_, POWERLAW_N0, limits);
-        // The search's resolution (1/4096 of the box without one).
-        let resolution = [0, 1].map(|k| {
-            if region.resolution[k] > 0.0 {
-                region.resolution[k]
-            } else {
-                (box_[k].1 - box_[k].0) / 4096.0
-            }
-        });
-        bnb.set_resolution(resolution);
+        bnb.set_resolution([0, 1].map(|k| resolution_of(region, box_, k)));
         let tau_of = |u: f64| tolerance(obj, u);
         let ab_local = [1, 2].map(|k| local.0.get(k).copied().unwrap_or(f64::NAN));
         let u0 = best.1.min(target);
