@@ -572,6 +572,18 @@ fn one_cell_case(col: &str, row: usize, value: &str, model: &str) -> Case {
     )
 }
 
+/// Found by `fit_takes_any_number_in_any_cell` in CI on 2026-11-27: a diameter of 3.8e-90 mm in
+/// a power-law fit of 12 rows gives a search region of 41 931 cells, and each slice of A's
+/// profile started on all of them. The slice's start looked for repeated corners in a list
+/// (quadratic: 24 s of CPU) and then ran out of its budget anyway; a slice now says it is not
+/// shown global when the region crosses it in more cells than its budget (0.4 s).
+#[test]
+fn a_power_law_over_a_diameter_of_1e_minus_90_mm_ends_within_the_limit() {
+    let value = format!("{}", 3.7692196493170435e-90);
+    let case = one_cell_case("d_mm", 1, &value, "powerlaw");
+    assert_clean(&run_all("tiny-d", &[case]));
+}
+
 /// Any f64 at all, as Rust prints it (finite, subnormal, huge, zero, negative, NaN, inf).
 fn any_number() -> impl Strategy<Value = String> {
     prop_oneof![
