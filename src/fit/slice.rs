@@ -149,25 +149,18 @@ struct Slice<'a> {
     limits: Limits,
 }
 
-/// The local minimisation's point and chi2 where the global search's region does not reach the
-/// slice: no point of it has chi2 below the target.
-fn nothing_below(best: (Vec<f64>, f64)) -> SliceMinimum {
-    SliceMinimum {
-        theta: best.0,
-        chi2: best.1,
-        certified: true,
-    }
-}
-
-/// The local minimisation's point and chi2, not shown to be the slice's minimum: the search's
-/// region crosses the slice in more cells than the slice's budget (fuzz: 41 931 region cells
-/// on 12 points with a diameter of 3.8e-90 mm, whose bounds, in every slice of A's profile,
-/// took 0.55 s of CPU and would then have run out of budget).
-fn over_budget(best: (Vec<f64>, f64)) -> SliceMinimum {
-    SliceMinimum {
-        theta: best.0,
-        chi2: best.1,
-        certified: false,
+impl SliceMinimum {
+    /// The local minimisation's point and chi2 `best`, the slice not searched: `certified` where
+    /// the global search's region does not reach the slice (no point of it has chi2 below the
+    /// target); not where the region crosses the slice in more cells than the slice's budget
+    /// (fuzz: 41 931 region cells on 12 points with a diameter of 3.8e-90 mm, whose bounds, in
+    /// every slice of A's profile, took 0.55 s of CPU and would then have run out of budget).
+    fn local(best: (Vec<f64>, f64), certified: bool) -> Self {
+        SliceMinimum {
+            theta: best.0,
+            chi2: best.1,
+            certified,
+        }
     }
 }
 
@@ -228,10 +221,10 @@ impl Slice<'_> {
         spans.sort_by_key(|&(a, b)| (a, std::cmp::Reverse(b)));
         spans.dedup_by(|inner, outer| inner.1 <= outer.1);
         if spans.is_empty() {
-            return Ok(nothing_below(best));
+            return Ok(SliceMinimum::local(best, true));
         }
         if spans.len() > limits.max_cells as usize {
-            return Ok(over_budget(best));
+            return Ok(SliceMinimum::local(best, false));
         }
         let mut range = box_;
         range[h] = (t, t);
@@ -283,20 +276,14 @@ impl Slice<'_> {
     /// range, so with A = t too), its grid-local minima polished by Levenberg-Marquardt over
     /// the exponents.
     fn held_amplitude(&self, land: PowerLaw, box_: [(f64, f64); 2]) -> Result<SliceMinimum> {
-        let Slice {
-            obj,
-            t,
-            local,
-            target,
-            region,
-            limits,
-        } = *self;
+        let (obj, t, local, target) = (self.obj, self.t, self.local, self.target);
+        let (region, limits) = (self.region, self.limits);
         let best = self.local_best();
         if region.cells.is_empty() {
-            return Ok(nothing_below(best));
+            return Ok(SliceMinimum::local(best, true));
         }
         if region.cells.len() > limits.max_cells as usize {
-            return Ok(over_budget(best));
+            return Ok(SliceMinimum::local(best, false));
         }
         let cells: Vec<([u64; 2], [u64; 2])> = region.cells.iter().map(|c| (c.p0, c.p1)).collect();
         let mut bnb = Bnb::sparse(land, box_, POWERLAW_N0, limits);
