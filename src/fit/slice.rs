@@ -197,14 +197,7 @@ impl Slice<'_> {
         at: &dyn Fn(f64) -> Vec<f64>,
         chi2: &dyn Fn(f64) -> Result<f64>,
     ) -> Result<SliceMinimum> {
-        let Slice {
-            obj,
-            t,
-            local,
-            target,
-            region,
-            limits,
-        } = *self;
+        let (t, local, region, limits) = (self.t, self.local, self.region, self.limits);
         let [h, o] = axes;
         let best = self.local_best();
         // The search's cells the slice crosses (cells are closed: one on either side of t when
@@ -243,20 +236,11 @@ impl Slice<'_> {
         let mut resolution = [0.0; 2];
         resolution[o] = resolution_of(region, box_, o);
         bnb.set_resolution(resolution);
-        let tau_of = |u: f64| tolerance(obj, u);
         let x_local = local.0.get(x_at).copied().unwrap_or(f64::NAN);
-        // Near the profile's crossing the local value is within tau of the target, and the
-        // cells around the local minimum go to the resolution whatever their bounds: not
-        // bounded on the way (a third to a half of such a slice's cell bounds on 100 000
-        // points).
-        let u0 = best.1.min(target);
-        if local.2 && x_local.is_finite() && best.1 <= u0 + tau_of(u0) {
-            let mut p = [0.0; 2];
-            p[h] = t;
-            p[o] = x_local;
-            bnb.set_polished(p);
-        }
-        bnb.start_on(&cells, u0 - tau_of(u0));
+        let mut at_local = [0.0; 2];
+        at_local[h] = t;
+        at_local[o] = x_local;
+        self.start(&mut bnb, &cells, &best, at_local);
         // Brent's method on the bracket, not where the local minimisation already polished (as
         // the search: a polished point inside the bracket); 1e-10 in the internal coordinate, as
         // the one-parameter polishes: far below any standard error.
@@ -276,7 +260,7 @@ impl Slice<'_> {
     /// range, so with A = t too), its grid-local minima polished by Levenberg-Marquardt over
     /// the exponents.
     fn held_amplitude(&self, land: PowerLaw, box_: [(f64, f64); 2]) -> Result<SliceMinimum> {
-        let (obj, t, local, target) = (self.obj, self.t, self.local, self.target);
+        let (obj, t, local) = (self.obj, self.t, self.local);
         let (region, limits) = (self.region, self.limits);
         let best = self.local_best();
         if region.cells.is_empty() {
@@ -288,13 +272,8 @@ impl Slice<'_> {
         let cells: Vec<([u64; 2], [u64; 2])> = region.cells.iter().map(|c| (c.p0, c.p1)).collect();
         let mut bnb = Bnb::sparse(land, box_, POWERLAW_N0, limits);
         bnb.set_resolution([0, 1].map(|k| resolution_of(region, box_, k)));
-        let tau_of = |u: f64| tolerance(obj, u);
         let ab_local = [1, 2].map(|k| local.0.get(k).copied().unwrap_or(f64::NAN));
-        let u0 = best.1.min(target);
-        if local.2 && ab_local.iter().all(|x| x.is_finite()) && best.1 <= u0 + tau_of(u0) {
-            bnb.set_polished(ab_local);
-        }
-        bnb.start_on(&cells, u0 - tau_of(u0));
+        self.start(&mut bnb, &cells, &best, ab_local);
         let lm = lsq::LmOptions::default();
         let polish = |c: &Candidate| -> Result<Option<(Vec<f64>, f64)>> {
             let inside =
@@ -306,6 +285,26 @@ impl Slice<'_> {
             Ok(Some((r.theta, r.chi2)))
         };
         self.search(bnb, best, &|tt| vec![t, tt[0], tt[1]], &polish)
+    }
+
+    /// Starts `bnb` on `cells` against the lower of `best`'s chi2 and the target, less tau.
+    /// Near the profile's crossing the local value is within tau of the target, and the cells
+    /// around the local minimum (at `at_local`, the landscape's coordinates) go to the
+    /// resolution whatever their bounds: not bounded on the way (a third to a half of such a
+    /// slice's cell bounds on 100 000 points).
+    fn start<L: Landscape>(
+        &self,
+        bnb: &mut Bnb<L>,
+        cells: &[([u64; 2], [u64; 2])],
+        best: &(Vec<f64>, f64),
+        at_local: [f64; 2],
+    ) {
+        let tau_of = |u: f64| tolerance(self.obj, u);
+        let u0 = best.1.min(self.target);
+        if self.local.2 && at_local.iter().all(|x| x.is_finite()) && best.1 <= u0 + tau_of(u0) {
+            bnb.set_polished(at_local);
+        }
+        bnb.start_on(cells, u0 - tau_of(u0));
     }
 
     /// The slice's branch and bound from its starting cells, with `best` (the local
