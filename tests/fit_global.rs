@@ -599,3 +599,109 @@ fn power_law_ends_are_not_short_of_the_95_percent_region() {
     }
     assert!(short.is_empty(), "{short:#?}");
 }
+
+/// A part of the 95% region between the search grid's nodes, beyond the end the profile from
+/// the minimum reaches ([`restitution::fit::beyond`]). `pm` on a 25.4 mm nylon pair: 30 points
+/// at 8-31 m/s from sigma_y = 4e7 Pa without noise, their error set so that chi2 of those points
+/// is 23 at 0.3 below in ln sigma_y; and one point at the speed where sigma_y 0.27 below starts
+/// to yield, its e that of 0.3 below and its error such that it adds 20 while elastic. The
+/// minimum (chi2 20) is at 4e7 Pa with that point elastic; chi2 falls below the threshold
+/// (23.84) again only where that point yields to its e, in a dip about 0.007 wide in ln sigma_y
+/// near 2.96e7 Pa, past a ridge. A brute-force scan of chi2 from the model (20 001 points over
+/// 1.5 in ln sigma_y) must see the two parts, and the interval must reach the scan's lowest
+/// point inside the threshold: before, the lower end stayed at 3.536e7 Pa with no warning (no
+/// grid node fell into the dip).
+#[test]
+fn a_part_of_the_95_percent_region_between_the_grid_nodes_moves_the_end() {
+    let m = Material::preset("nylon").unwrap();
+    let d = 25.4;
+    let c = pair_contact(m, d, None).unwrap();
+    let pm = |v: f64, s: f64| {
+        predict_e(
+            ModelKind::Pm,
+            &c,
+            v,
+            &[s],
+            ContactEnd::Overlap,
+            &VmMethod::Master,
+        )
+        .unwrap()
+    };
+    let sigma_a = 4e7f64;
+    let sigma_dip = (sigma_a.ln() - 0.3).exp();
+    let speeds: Vec<f64> = (0..30).map(|k| 8.0 * (1.0 + k as f64 / 10.0)).collect();
+    let at_dip: f64 = speeds
+        .iter()
+        .map(|&v| (pm(v, sigma_dip) - pm(v, sigma_a)).powi(2))
+        .sum();
+    let err = (at_dip / 23.0).sqrt();
+    // The speed where sigma_y 0.03 above the dip starts to yield (bisection on e < 1).
+    let sigma_p = (sigma_dip.ln() + 0.03).exp();
+    let (mut lo, mut hi) = (1e-6f64, 100.0f64);
+    for _ in 0..200 {
+        let mid = (lo * hi).sqrt();
+        if pm(mid, sigma_p) < 1.0 {
+            hi = mid
+        } else {
+            lo = mid
+        }
+    }
+    let (v_p, e_p) = (hi, pm(hi, sigma_dip));
+    let err_p = (1.0 - e_p) / 20f64.sqrt();
+    let mut obs: Vec<Observation> = speeds
+        .iter()
+        .map(|&v| Observation {
+            d_mm: d,
+            d2_mm: None,
+            v_n_m_s: v,
+            e: pm(v, sigma_a),
+            e_err: Some(err),
+        })
+        .collect();
+    obs.push(Observation {
+        d_mm: d,
+        d2_mm: None,
+        v_n_m_s: v_p,
+        e: e_p,
+        e_err: Some(err_p),
+    });
+    let data = FitData::new(m, obs.clone()).unwrap();
+    let r = fit(&data, ModelKind::Pm, &FitOptions::default()).unwrap();
+    assert!(
+        r.converged && r.global.certified && r.warnings.is_empty(),
+        "{:?}",
+        r.warnings
+    );
+    let threshold = r.chi2 + r.ci95_delta_chi2;
+    let chi2 = |s: f64| -> f64 {
+        obs.iter()
+            .map(|o| ((o.e - pm(o.v_n_m_s, s)) / o.e_err.unwrap()).powi(2))
+            .sum()
+    };
+    let n = 20_000;
+    let step = 1.5 / n as f64;
+    let inside: Vec<f64> = (0..=n)
+        .map(|k| sigma_a.ln() - 1.0 + step * k as f64)
+        .filter(|&t| chi2(t.exp()) < threshold)
+        .collect();
+    // Two parts: a gap of more than 0.05 in ln sigma_y between consecutive inside points.
+    let gaps = inside.windows(2).filter(|w| w[1] - w[0] > 0.05).count();
+    assert_eq!(gaps, 1, "{inside:?}");
+    let lowest = inside[0];
+    let end = r.params[0].ci95.0.unwrap().ln();
+    // Not short of the scan's lowest inside point, and within two of its steps of it (the
+    // crossing lies between that point and the one below).
+    assert!(
+        end <= lowest && end >= lowest - 2.0 * step,
+        "end {} scan {}",
+        end.exp(),
+        lowest.exp()
+    );
+    assert!(
+        r.notes
+            .iter()
+            .any(|n| n.contains("lower end of the 95% interval of sigma_y moved")),
+        "{:?}",
+        r.notes
+    );
+}

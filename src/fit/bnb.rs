@@ -184,6 +184,24 @@ pub struct CellBox {
     pub t1: [f64; 2],
 }
 
+/// A half-plane of the box ([`Bnb::set_cut`]): the points whose coordinate on `axis` is `at` or
+/// beyond it in direction `dir` (+1 above, -1 below); a cell straddling `at` is split on `axis`
+/// down to `width`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cut {
+    pub axis: usize,
+    pub at: f64,
+    pub dir: f64,
+    pub width: f64,
+}
+
+impl Cut {
+    /// Whether internal coordinate `t` on the cut's axis lies on the searched side (at `at` too).
+    fn keeps(&self, t: f64) -> bool {
+        (t - self.at) * self.dir >= 0.0
+    }
+}
+
 /// Budgets of a [`Bnb`].
 #[derive(Debug, Clone, Copy)]
 pub struct Limits {
@@ -214,6 +232,8 @@ pub struct Bnb<L: Landscape> {
     resolution: [f64; 2],
     /// A point a local minimisation converged at ([`Bnb::set_polished`]).
     polished: Option<[f64; 2]>,
+    /// The half-plane the search is restricted to ([`Bnb::set_cut`]).
+    cut: Option<Cut>,
     /// Starting grid, for [`Bnb::initial_minima`].
     start_cells: Vec<Cell>,
     pub cells: u64,
@@ -251,6 +271,7 @@ impl<L: Landscape> Bnb<L> {
             fine: Vec::new(),
             resolution: [0.0, 0.0],
             polished: None,
+            cut: None,
             start_cells: Vec::new(),
             cells: 0,
             limits,
@@ -480,7 +501,8 @@ impl<L: Landscape> Bnb<L> {
 
     fn record_node(&mut self, p: [u64; 2], r: [usize; 2], v: f64) {
         self.nodes.insert(r, v);
-        if !v.is_nan() && self.best.is_none_or(|(_, b)| v < b) {
+        // A node outside the cut is no point of the search (its chi2 may well be lower).
+        if self.searched(p) && !v.is_nan() && self.best.is_none_or(|(_, b)| v < b) {
             self.best = Some((p, v));
         }
     }
@@ -540,6 +562,13 @@ impl<L: Landscape> Bnb<L> {
             coarse |= hi - lo > self.resolution[k];
         }
         inside && coarse
+    }
+
+    /// Restricts the search to the half-plane `cut` (see [`Cut`]): cells wholly outside it are
+    /// dropped, nodes outside it are not the best node, and a cell across its `at` is split on
+    /// its axis down to its width. Before the starting cells ([`Bnb::start_on`]).
+    pub fn set_cut(&mut self, cut: Cut) {
+        self.cut = Some(cut);
     }
 
     /// A point a local minimisation converged at: the cells holding it are split down to the
@@ -631,7 +660,9 @@ impl<L: Landscape> Bnb<L> {
     }
 
     fn push(&mut self, c: Cell, u: f64, tau_of: &dyn Fn(f64) -> f64, keep_of: &dyn Fn(f64) -> f64) {
-        if c.failed {
+        if !self.within_cut(&c) {
+            // No point of it is searched (its edge on the cut, at `at`, is in the cells beyond).
+        } else if c.failed {
             let why = self
                 .row_failures
                 .first()
@@ -648,6 +679,31 @@ impl<L: Landscape> Bnb<L> {
         }
     }
 
+    /// Whether the node at dyadic position `p` lies in the cut's half-plane (all, without one).
+    fn searched(&self, p: [u64; 2]) -> bool {
+        self.cut
+            .is_none_or(|c| c.keeps(self.axes[c.axis].t_at(p[c.axis])))
+    }
+
+    /// Whether some point of the cell lies in the cut's half-plane (all, without a cut), not
+    /// counting an edge on the cut's `at` (it belongs to a cell beyond too).
+    fn within_cut(&self, c: &Cell) -> bool {
+        self.cut.is_none_or(|k| {
+            let a = &self.axes[k.axis];
+            let (t0, t1) = (a.t_at(c.p0[k.axis]), a.t_at(c.p1[k.axis]));
+            if k.dir > 0.0 { t1 > k.at } else { t0 < k.at }
+        })
+    }
+
+    /// Whether the cell crosses the cut's `at` and is wider than its width on the cut's axis.
+    fn straddles_cut(&self, c: &Cell) -> bool {
+        self.cut.is_some_and(|k| {
+            let a = &self.axes[k.axis];
+            let (t0, t1) = (a.t_at(c.p0[k.axis]), a.t_at(c.p1[k.axis]));
+            t0 < k.at && k.at < t1 && t1 - t0 > k.width
+        })
+    }
+
     fn split(&mut self, c: &Cell) -> Split {
         let width = |k: usize| self.axes[k].t_at(c.p1[k]) - self.axes[k].t_at(c.p0[k]);
         let coarse = |k: usize| self.axes[k].active && width(k) > self.resolution[k];
@@ -658,10 +714,20 @@ impl<L: Landscape> Bnb<L> {
         let lall = max_over(&|k| self.axes[k].active);
         // Split the coarse axes that carry the most looseness (both when comparable); a coarse
         // axis with none to speak of (a plateau: the model does not change along it; 1e-6 of
-        // the largest is rounding) is not worth it.
-        let pick: Vec<usize> = (0..2)
-            .filter(|&k| coarse(k) && l[k] > 1e-6 * lall && l[k] >= 0.5 * lmax)
-            .collect();
+        // the largest is rounding) is not worth it. A cell across a cut is split on the cut's
+        // axis alone, whatever its looseness: its bound covers points outside the cut (inside
+        // an interval, below the target), which no split elsewhere removes.
+        let across = self
+            .straddles_cut(c)
+            .then(|| self.cut.map(|k| k.axis))
+            .flatten();
+
+        let pick: Vec<usize> = match across {
+            Some(k) => vec![k],
+            None => (0..2)
+                .filter(|&k| coarse(k) && l[k] > 1e-6 * lall && l[k] >= 0.5 * lmax)
+                .collect(),
+        };
         if pick.is_empty() {
             return Split::Fine;
         }

@@ -25,6 +25,7 @@
 
 mod summary;
 
+use super::beyond::{Certified, Unshown, certify_ends};
 use super::compare::{Comparison, compare};
 use super::dataset::{FitData, Merged};
 use super::lsq;
@@ -130,6 +131,7 @@ fn fit_points(
     }
     let mut profiles = None;
     let mut moved: Vec<Moved> = Vec::new();
+    let mut unshown: Vec<Unshown> = Vec::new();
     if options.intervals {
         let mut refits = 0;
         loop {
@@ -144,7 +146,25 @@ fn fit_points(
                         match extend_to_region(&obj, best.chi2, &cov, &mut p, &near_nodes, inner)? {
                             Extension::Done(m) => {
                                 moved = m;
-                                ProfileOutcome::Done(p)
+                                // Then past the parts between the grid's nodes.
+                                match region.as_ref() {
+                                    Some(region) => match certify_ends(
+                                        &obj,
+                                        (&best.theta, best.chi2),
+                                        &cov,
+                                        &mut p,
+                                        region,
+                                        inner,
+                                        &mut moved,
+                                    )? {
+                                        Certified::Done(u) => {
+                                            unshown = u;
+                                            ProfileOutcome::Done(p)
+                                        }
+                                        Certified::Lower(t) => ProfileOutcome::Lower(t),
+                                    },
+                                    None => ProfileOutcome::Done(p),
+                                }
                             }
                             Extension::Lower(t) => ProfileOutcome::Lower(t),
                         }
@@ -202,6 +222,9 @@ fn fit_points(
         for m in &moved {
             notes.push(moved_note(&obj, p, m));
         }
+        for u in &unshown {
+            warnings.push(unshown_warning(&obj, u));
+        }
         check_disjoint(&obj, &r, p, &near_nodes, &mut warnings);
     }
     r.converged = converged;
@@ -240,6 +263,20 @@ fn moved_note(obj: &Objective, p: &Profiles, m: &Moved) -> String {
         Num(m.chi2 + obj.chi2_offset),
         spec.key,
         show(m.point[m.j]),
+    )
+}
+
+/// The warning for an end whose far side could not be cleared of the 95% region.
+fn unshown_warning(obj: &Objective, u: &Unshown) -> String {
+    let spec = &obj.kind.params()[u.j];
+    let show = |t: f64| Num(if spec.log { t.exp() } else { t });
+    format!(
+        "{}: not shown that the 95% region has no part beyond the {} end of its interval ({}): \
+         {}; the interval may be too short",
+        spec.key,
+        ["lower", "upper"][u.s],
+        show(u.end),
+        u.why
     )
 }
 

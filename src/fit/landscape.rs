@@ -127,13 +127,14 @@ mod tests {
         check_bounds_held(d, kind, cells, None);
     }
 
-    /// [`check_bounds_on`], for the power law with ln A held at `held` where given
-    /// ([`PowerLaw::hold_amplitude`]: chi2 at that A, not its minimum over A).
+    /// [`check_bounds_on`], for the power law with ln A held in `held` = (lo, hi) where given
+    /// ([`PowerLaw::amplitude_range`]: chi2 minimised over that range of A, not over A's box; at
+    /// one value when lo = hi, [`PowerLaw::hold_amplitude`]).
     fn check_bounds_held(
         d: &FitData,
         kind: ModelKind,
         cells: &[([f64; 2], [f64; 2])],
-        held: Option<f64>,
+        held: Option<(f64, f64)>,
     ) {
         let ev = Evaluator::new(d, ContactEnd::Overlap, VmMethod::Master);
         let obj = Objective::new(&ev, kind).unwrap();
@@ -144,21 +145,25 @@ mod tests {
                     ModelKind::Pm => vec![t[1]],
                     ModelKind::Min | ModelKind::Product => vec![t[0], t[1]],
                     ModelKind::PowerLaw => {
-                        vec![
-                            held.unwrap_or_else(|| {
-                                super::super::powerlaw::ProfiledPowerLaw::new(&obj).ln_a(&t)
-                            }),
-                            t[0],
-                            t[1],
-                        ]
+                        // chi2 is a convex quadratic in A: its least-squares A kept in the
+                        // range is its minimum over the range.
+                        let ln_a = super::super::powerlaw::ProfiledPowerLaw::new(&obj).ln_a(&t);
+                        let ln_a = match held {
+                            Some((lo, hi)) if lo == hi => lo,
+                            Some((lo, hi)) => ln_a.clamp(lo, hi),
+                            None => ln_a,
+                        };
+                        vec![ln_a, t[0], t[1]]
                     }
                 };
                 lsq::chi2(&obj, &theta).unwrap()
             };
             let bound = if kind == ModelKind::PowerLaw {
                 let mut l = PowerLaw::new(&obj);
-                if let Some(ln_a) = held {
-                    l.hold_amplitude(ln_a);
+                match held {
+                    Some((lo, hi)) if lo == hi => l.hold_amplitude(lo),
+                    Some((lo, hi)) => l.amplitude_range(lo, hi),
+                    None => {}
                 }
                 for k in 0..2 {
                     l.add_row(k, lo[k]).unwrap();
@@ -174,8 +179,8 @@ mod tests {
                 let mut b = at(&l, f64::NEG_INFINITY).max(at(&l, f64::INFINITY));
                 let corners = [[0, 0], [1, 0], [0, 1], [1, 1]].map(|r| l.node(r));
                 if held.is_some() {
-                    // With A held a node is chi2 at that A (1e-12 relative: the same sums in
-                    // other orders).
+                    // With A held or ranged a node is chi2 at that A or at its minimum over the
+                    // range (1e-12 relative: the same sums in other orders).
                     for (r, v) in [[0, 0], [1, 0], [0, 1], [1, 1]].iter().zip(corners) {
                         let want = direct([[lo, hi][r[0]][0], [lo, hi][r[1]][1]]);
                         assert!(
@@ -318,7 +323,30 @@ mod tests {
         cells.extend(powerlaw_cells(&[1e-5, 0.01, 0.2, 1.0]));
         for d in [&base, &large] {
             for ln_a in [-2.2, -2.5, -1.9, -8.0, 1.0] {
-                check_bounds_held(d, ModelKind::PowerLaw, &cells, Some(ln_a));
+                check_bounds_held(d, ModelKind::PowerLaw, &cells, Some((ln_a, ln_a)));
+            }
+        }
+    }
+
+    #[test]
+    fn power_law_bounds_with_a_in_a_range_are_below_chi2_minimised_over_it() {
+        // The landscape beyond an end of A's interval ([`crate::fit::beyond`]): A's range cut
+        // to one side of a value. Its nodes are chi2 at the least-squares A kept in the range
+        // and its bounds lie below that over each cell: ranges that hold the best A (ln A about
+        // -2.2 on the pattern), lie below or above it, or far from it; small and large data.
+        let base = data();
+        let large = distinct(&base, crate::fit::sums::PARALLEL_MIN_POINTS + 1000);
+        let mut cells = vec![([0.3, 0.1], [0.7, 0.5]), ([-3.0, 2.0], [1.0, 4.0])];
+        cells.extend(powerlaw_cells(&[1e-5, 0.01, 0.2, 1.0]));
+        for d in [&base, &large] {
+            for range in [
+                (-3.0, -1.0),
+                (-2.1, 0.5),
+                (-9.0, -2.3),
+                (-12.0, -8.0),
+                (1.0, 3.0),
+            ] {
+                check_bounds_held(d, ModelKind::PowerLaw, &cells, Some(range));
             }
         }
     }

@@ -1,6 +1,7 @@
 //! Fitting measured coefficients of restitution: models, least squares, a certified global
 //! search, uncertainties, comparison, reports.
 
+pub mod beyond;
 pub mod bnb;
 pub mod compare;
 pub mod covariance;

@@ -250,7 +250,7 @@ const RESOLUTION_SMOOTH: f64 = 1.0;
 const RESOLUTION_1D: f64 = 0.25;
 
 /// Maps a landscape cell (grid indices and offsets) to the model's parameters.
-type ToTheta<'a, L> = &'a dyn Fn(&L, [usize; 2], [f64; 2]) -> Vec<f64>;
+pub(crate) type ToTheta<'a, L> = &'a dyn Fn(&L, [usize; 2], [f64; 2]) -> Vec<f64>;
 
 /// The common driver: initial minima, branch and bound, candidates, certificate.
 fn run<L: Landscape>(
@@ -336,10 +336,7 @@ fn run<L: Landscape>(
     }
     // For the profiles of the two-parameter models and the power law, the cells that may hold
     // chi2 within 3.84 s of the minimum are kept ([`Region`]).
-    let keeps_region = matches!(
-        obj.kind,
-        ModelKind::Min | ModelKind::Product | ModelKind::PowerLaw
-    );
+    let keeps_region = true;
     let keep_of = |u: f64| {
         if keeps_region {
             u + CHI2_1DOF_95 * obj.scale(u)

@@ -118,7 +118,10 @@ impl<L: Landscape> Bnb<L> {
 
     /// Local minima among the nodes of the cells that may still hold a point at or below
     /// `upper`: for each such cell its lowest corner, kept when it is not above its neighbours at
-    /// the cell's own scale (ties broken by position). Lowest first.
+    /// the cell's own scale (ties broken by position). Lowest first. With a cut
+    /// ([`Bnb::set_cut`]) only the nodes in its half-plane count, as corners and as neighbours:
+    /// the minima of the search restricted to it (on the cut's edge, where chi2 falls across
+    /// it, a node beyond is a local minimum of the restricted search though not of the grid).
     pub fn candidates(&mut self, upper: f64) -> Vec<Candidate> {
         let cells: Vec<Cell> = self
             .done
@@ -134,6 +137,9 @@ impl<L: Landscape> Bnb<L> {
             let corners = [c.p0, [c.p1[0], c.p0[1]], [c.p0[0], c.p1[1]], c.p1];
             let mut low = (f64::INFINITY, c.p0);
             for p in corners {
+                if !self.searched(p) {
+                    continue;
+                }
                 let (v, _) = self.node_at(p);
                 if v < low.0 {
                     low = (v, p);
@@ -156,6 +162,9 @@ impl<L: Landscape> Bnb<L> {
                     }
                     let mut pq = p;
                     pq[k] = q as u64;
+                    if !self.searched(pq) {
+                        continue;
+                    }
                     let (u, _) = self.node_at(pq);
                     if u < v || (u == v && (pq[0], pq[1]) < (p[0], p[1])) {
                         is_min = false;

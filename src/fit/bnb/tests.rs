@@ -390,3 +390,53 @@ fn cells_around_a_polished_point_are_left_at_the_resolution() {
         assert!(v < 0.01 && (t[0] - 2.0).abs() < 0.1, "{t:?} {v}");
     }
 }
+
+/// [`Bnb::set_cut`]: restricted to x <= 1.9, the search sees the minimum of that half-plane
+/// (g(1.9) = 0.01 on its edge), not the box's (0 at x = 2, beyond it). Against a target of
+/// 0.005 no point of the half-plane is lower: certified to tau although the cells across
+/// x = 1.9 hold the box's minimum (they are split on x down to the cut's width, 0.01, where
+/// none reaches past 1.91, g >= 0.0081), and no node beyond the cut is taken as the best.
+/// Against 0.02 a node below it is found, on the searched side.
+#[test]
+fn a_search_restricted_to_a_half_plane_ignores_what_lies_beyond() {
+    let tau = |_: f64| 1e-4;
+    let cut = Cut {
+        axis: 0,
+        at: 1.9,
+        dir: -1.0,
+        width: 0.01,
+    };
+    let mut b = sparse_two_wells(false);
+    b.set_cut(cut);
+    b.start_on(&grid_cells(0..10), 0.005 - 1e-4);
+    b.refine(0.005, &tau, &|u| u);
+    if let Some((_, t, v)) = b.best_node() {
+        assert!(v >= 0.005 && t[0] <= 1.9, "{t:?} {v}");
+    }
+    let c = b.certificate(0.005);
+    assert!(
+        c.lowest >= 0.005 - 1e-4 && c.reasons.is_empty() && c.fine_cells == 0,
+        "{c:?}"
+    );
+    for c in b.cells_below(f64::INFINITY) {
+        assert!(c.t0[0] < 1.9, "{c:?}");
+        if c.t1[0] > 1.9 {
+            assert!(c.t1[0] - c.t0[0] <= 0.01, "{c:?}");
+        }
+    }
+    // Without the cut the same cells hold chi2 0 < 0.005.
+    let mut b = sparse_two_wells(false);
+    b.start_on(&grid_cells(0..10), 0.005 - 1e-4);
+    b.refine(0.005, &tau, &|u| u);
+    assert!(b.best_node().unwrap().2 < 0.005);
+    // A target the half-plane reaches below.
+    let mut b = sparse_two_wells(false);
+    b.set_cut(cut);
+    b.start_on(&grid_cells(0..10), 0.02 - 1e-4);
+    b.refine(0.02, &tau, &|u| u);
+    let (_, t, v) = b.best_node().unwrap();
+    assert!((0.01..0.02).contains(&v) && t[0] <= 1.9, "{t:?} {v}");
+    for c in b.candidates(0.02) {
+        assert!(c.t[0] <= 1.9, "{c:?}");
+    }
+}

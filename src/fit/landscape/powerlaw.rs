@@ -136,8 +136,13 @@ impl<'a> PowerLaw<'a> {
     /// the cell bounds (which minimise over A's range) bound chi2 over the exponents with A
     /// held (the profile of A: [`crate::fit::slice`]).
     pub fn hold_amplitude(&mut self, ln_a: f64) {
-        let a = ln_a.exp();
-        self.a_range = (a, a);
+        self.amplitude_range(ln_a, ln_a);
+    }
+
+    /// A's range cut to exp(ln_lo) ..= exp(ln_hi): the nodes and cell bounds minimise over it
+    /// (the part of the region beyond an end of A's interval: [`crate::fit::beyond`]).
+    pub fn amplitude_range(&mut self, ln_lo: f64, ln_hi: f64) {
+        self.a_range = (ln_lo.exp(), ln_hi.exp());
     }
 
     /// ln of the factor between A and the centred amplitude: A_c = A exp(-a m1 + b m2).

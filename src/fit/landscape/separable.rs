@@ -134,6 +134,13 @@ impl<'a> Separable<'a> {
         &self.rows[k][r]
     }
 
+    /// The second-order bound for small data too (where no fit's polish depends on where the
+    /// cells end: the region beyond an interval's end, [`crate::fit::beyond`]).
+    pub fn with_second_order(mut self) -> Self {
+        self.second_order = true;
+        self
+    }
+
     /// The cell on the sampled points (large data).
     fn sample_cell(&self, lo: [usize; 2], hi: [usize; 2]) -> Cell<'_> {
         let full = self.cell(lo, hi);
