@@ -10,9 +10,10 @@
 //! cargo run --release --example interval_scan -- --powerlaw FROM TO
 //! ```
 //!
-//! `--moved` only counts, over every model's fit (`fit_all`), the ends moved past a grid node of
-//! the 95% region (the fits' notes) and the parts of the region still outside an interval (their
-//! warnings): fast, no brute force.
+//! `--moved` only counts, over every model's fit (`fit_all`), the ends moved past a point of the
+//! 95% region (a grid node, or one the search beyond the end found: the fits' notes), the parts
+//! of the region still outside an interval and the ends whose far side could not be cleared
+//! (their warnings): fast, no brute force.
 //!
 //! `--powerlaw` does the same for the power law's exponents a and b: beyond an end of one, the
 //! least chi2 over 1500 values of the other across its box then Brent's method around the best,
@@ -144,7 +145,7 @@ fn count_moved(from: u64, to: u64) {
         ModelKind::Product,
         ModelKind::PowerLaw,
     ];
-    let (mut fits, mut moved, mut outside) = (0, 0, 0);
+    let (mut fits, mut moved, mut outside, mut unshown) = (0, 0, 0, 0);
     for seed in from..to {
         let c = cases::make_case(seed);
         let options = FitOptions {
@@ -156,17 +157,27 @@ fn count_moved(from: u64, to: u64) {
         };
         for r in &set.fits {
             fits += 1;
-            moved += r.notes.iter().filter(|n| n.contains("95% region")).count();
+            for n in r.notes.iter().filter(|n| n.contains("95% region")) {
+                moved += 1;
+                println!("seed {seed} {}: {n}", r.model);
+            }
             outside += r
                 .warnings
                 .iter()
                 .filter(|w| w.contains("has a part outside the interval"))
                 .count();
+            for w in &r.warnings {
+                if w.contains("not shown that the 95% region has no part beyond") {
+                    unshown += 1;
+                    println!("seed {seed} {}: {w}", r.model);
+                }
+            }
         }
     }
     println!(
-        "seeds {from}..{to}: {fits} fits, {moved} interval ends moved past a grid node of the 95% \
-         region, {outside} parts of the region still outside an interval"
+        "seeds {from}..{to}: {fits} fits, {moved} interval ends moved past a point of the 95% \
+         region (a grid node, or found beyond the end), {outside} parts of the region still \
+         outside an interval, {unshown} ends whose far side could not be cleared"
     );
 }
 

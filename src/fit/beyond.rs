@@ -11,7 +11,7 @@
 //! reach, beyond a ridge) is seen only where a node of the global search's grid falls into it
 //! ([`super::profile::extend_to_region`]). Between the nodes nothing showed that none lies.
 //!
-//! **Method**: the global search's own branch and bound ([`super::bnb`], with the cell bounds
+//! **Method** (docs/physics.md §7.5): the global search's own branch and bound ([`super::bnb`], with the cell bounds
 //! of the model's landscape, [`super::landscape`]) on the search's region, the cells whose
 //! bound is below the threshold (every other point of the box is shown above it), restricted to
 //! the half-plane theta_j >= end + margin (or <= end - margin): cells wholly inside are dropped,
@@ -21,7 +21,8 @@
 //! bound reaches the threshold less tau holds no such point; a node below the threshold is one;
 //! the cells left at the search's resolution get a local polish (Levenberg-Marquardt with
 //! theta_j held to the half-plane) from every grid-local minimum among them, as the search's
-//! fine cells do. The margin is [`MARGIN`] of the interval's half-width on that side: an end
+//! fine cells do (one whose bracket holds where an earlier polish ended is covered by it, as in
+//! the search). The margin is [`MARGIN`] of the interval's half-width on that side: an end
 //! may still be short by that much (a part of the region closer to the end than the margin
 //! differs from the interval by less).
 //!
@@ -35,7 +36,7 @@ use super::lsq::{self, Residuals};
 use super::models::ModelKind;
 use super::objective::Objective;
 use super::profile::{Extension, Inner, Moved, Profiles, Side, extend_to_region};
-use super::search::{POWERLAW_N0, Region, SEPARABLE_N0, TAU_ABS, ToTheta, tolerance};
+use super::search::{POWERLAW_N0, Region, SEPARABLE_N0, TAU_ABS, ToTheta, axes_of, tolerance};
 use super::sums;
 use crate::error::Result;
 use crate::models::viscoelastic::VmMethod;
@@ -44,8 +45,9 @@ use nalgebra::DMatrix;
 /// The margin beyond an end, as a fraction of the interval's half-width on that side.
 pub const MARGIN: f64 = 0.05;
 
-/// Local polishes allowed per end.
-const MAX_POLISH: usize = 8;
+/// Local polishes allowed per end (a candidate whose bracket holds where an earlier polish
+/// ended is not polished again, as in the search).
+const MAX_POLISH: usize = 20;
 
 /// What [`beyond_end`] established.
 #[derive(Debug, Clone, PartialEq)]
@@ -225,13 +227,6 @@ impl Search<'_> {
         let (obj, threshold) = (self.obj, self.threshold);
         let tau_of = |u: f64| tolerance(obj, u);
         let tau = tau_of(threshold);
-        if self.region.cells.len() > self.limits.max_cells as usize {
-            return Ok(Beyond::NotShown(format!(
-                "the search's region has {} cells, more than the budget of {}",
-                self.region.cells.len(),
-                self.limits.max_cells
-            )));
-        }
         // The region's cells with a point beyond the cut (its edge on `at` belongs to cells
         // beyond as well).
         let cells: Vec<([u64; 2], [u64; 2])> = (self.region.cells.iter())
@@ -246,6 +241,13 @@ impl Search<'_> {
             })
             .map(|c| (c.p0, c.p1))
             .collect();
+        if cells.len() > self.limits.max_cells as usize {
+            return Ok(Beyond::NotShown(format!(
+                "the search's region has {} cells beyond it, more than the budget of {}",
+                cells.len(),
+                self.limits.max_cells
+            )));
+        }
 
         bnb.set_resolution(self.region.resolution);
         bnb.start_on(&cells, threshold - tau);
@@ -256,10 +258,13 @@ impl Search<'_> {
             return Ok(Beyond::Found(to_theta(&bnb.land, r, t), v));
         }
         let mut polishes = 0;
+        let mut ended: Vec<[f64; 2]> = Vec::new();
         let lm = lsq::LmOptions::default();
         let free = vec![true; obj.kind.n_params()];
         for c in bnb.candidates(threshold) {
-            if c.lb >= threshold - tau {
+            let near =
+                |t: &[f64; 2]| (0..2).all(|k| c.bracket_lo[k] <= t[k] && t[k] <= c.bracket_hi[k]);
+            if c.lb >= threshold - tau || ended.iter().any(near) {
                 continue;
             }
             if polishes == MAX_POLISH {
@@ -280,7 +285,7 @@ impl Search<'_> {
                         r.reason
                     )));
                 }
-                Ok(_) => {}
+                Ok(r) => ended.push(axes_of(obj.kind, &r.theta)),
                 Err(e) => return Ok(Beyond::NotShown(format!("a local polish failed: {e}"))),
             }
         }

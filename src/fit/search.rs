@@ -252,6 +252,17 @@ const RESOLUTION_1D: f64 = 0.25;
 /// Maps a landscape cell (grid indices and offsets) to the model's parameters.
 pub(crate) type ToTheta<'a, L> = &'a dyn Fn(&L, [usize; 2], [f64; 2]) -> Vec<f64>;
 
+/// The coordinates on the branch and bound's axes of the parameters `th` of a `kind` model (its
+/// landscape's: e_vm's eta and e_pm's sigma_y, or the power law's exponents).
+pub(crate) fn axes_of(kind: ModelKind, th: &[f64]) -> [f64; 2] {
+    match kind {
+        ModelKind::Vm => [th[0], 0.0],
+        ModelKind::Pm => [0.0, th[0]],
+        ModelKind::Min | ModelKind::Product => [th[0], th[1]],
+        ModelKind::PowerLaw => [th[1], th[2]],
+    }
+}
+
 /// The common driver: initial minima, branch and bound, candidates, certificate.
 fn run<L: Landscape>(
     obj: &Objective,
@@ -286,14 +297,7 @@ fn run<L: Landscape>(
     let mut starts: Vec<[f64; 2]> = Vec::new();
     let mut n_polish = polished.len() as u64;
     let mut skipped = 0u64;
-    let axes_of = |th: &[f64]| -> [f64; 2] {
-        match obj.kind {
-            ModelKind::Vm => [th[0], 0.0],
-            ModelKind::Pm => [0.0, th[0]],
-            ModelKind::Min | ModelKind::Product => [th[0], th[1]],
-            ModelKind::PowerLaw => [th[1], th[2]],
-        }
-    };
+    let axes_of = |th: &[f64]| axes_of(obj.kind, th);
     let mut try_polish = |bnb: &Bnb<L>,
                           c: &Candidate,
                           polished: &mut Vec<Found>,
