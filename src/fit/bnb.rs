@@ -232,8 +232,10 @@ pub struct Bnb<L: Landscape> {
     resolution: [f64; 2],
     /// A point a local minimisation converged at ([`Bnb::set_polished`]).
     polished: Option<[f64; 2]>,
-    /// The half-plane the search is restricted to ([`Bnb::set_cut`]).
+    /// The half-plane the search is restricted to ([`Bnb::set_cut`]), and the row at its
+    /// edge once made ([`Bnb::clipped`]; not a dyadic position, so in no axis' `row_of`).
     cut: Option<Cut>,
+    cut_row: Option<usize>,
     /// Starting grid, for [`Bnb::initial_minima`].
     start_cells: Vec<Cell>,
     pub cells: u64,
@@ -272,6 +274,7 @@ impl<L: Landscape> Bnb<L> {
             resolution: [0.0, 0.0],
             polished: None,
             cut: None,
+            cut_row: None,
             start_cells: Vec::new(),
             cells: 0,
             limits,
@@ -642,7 +645,10 @@ impl<L: Landscape> Bnb<L> {
             let children = match self.split(&cell) {
                 Split::Cells(c) => c,
                 Split::Fine => {
-                    self.fine.push(cell);
+                    match self.clipped(&cell, u - tau) {
+                        Some(c) => self.done.push(c),
+                        None => self.fine.push(cell),
+                    }
                     continue;
                 }
                 Split::Finest => {
@@ -693,6 +699,59 @@ impl<L: Landscape> Bnb<L> {
             let (t0, t1) = (a.t_at(c.p0[k.axis]), a.t_at(c.p1[k.axis]));
             if k.dir > 0.0 { t1 > k.at } else { t0 < k.at }
         })
+    }
+
+    /// A cell at the resolution across the cut's `at`, bounded over its part in the half-plane
+    /// alone (between a row at `at` and its far edge): the cell with that bound where it
+    /// reaches `target` (it holds no searched point below it), else None. A cell across the cut
+    /// holds points outside it, inside an interval, whose chi2 is below the target: bounded
+    /// whole it could only be left to a polish.
+    fn clipped(&mut self, c: &Cell, target: f64) -> Option<Cell> {
+        let k = self.cut?;
+        let a = &self.axes[k.axis];
+        let (t0, t1) = (a.t_at(c.p0[k.axis]), a.t_at(c.p1[k.axis]));
+        if !(t0 < k.at && k.at < t1) {
+            return None;
+        }
+        let cut_row = self.cut_row(k)?;
+        let mut lo = [self.row(0, c.p0[0]), self.row(1, c.p0[1])];
+        let mut hi = [self.row(0, c.p1[0]), self.row(1, c.p1[1])];
+        if k.dir > 0.0 {
+            lo[k.axis] = cut_row;
+        } else {
+            hi[k.axis] = cut_row;
+        }
+        if !(self.rows_ok(lo) && self.rows_ok(hi)) {
+            return None;
+        }
+        self.cells += 1;
+        let bound = self.land.bound(lo, hi, target);
+        (bound.lb >= target).then_some(Cell { bound, ..*c })
+    }
+
+    /// The row at the cut's `at` on its axis (made once; None where the model fails there).
+    fn cut_row(&mut self, k: Cut) -> Option<usize> {
+        let r = match self.cut_row {
+            Some(r) => r,
+            None => {
+                let ok = match self.land.add_row(k.axis, k.at) {
+                    Ok(()) => true,
+                    Err(why) => {
+                        if self.row_failures.len() < 3 {
+                            self.row_failures.push(why);
+                        }
+                        false
+                    }
+                };
+                let a = &mut self.axes[k.axis];
+                let r = a.t.len();
+                a.t.push(k.at);
+                a.ok.push(ok);
+                self.cut_row = Some(r);
+                r
+            }
+        };
+        self.axes[k.axis].ok[r].then_some(r)
     }
 
     /// Whether the cell crosses the cut's `at` and is wider than its width on the cut's axis.
