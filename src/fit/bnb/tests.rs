@@ -396,7 +396,9 @@ fn cells_around_a_polished_point_are_left_at_the_resolution() {
 /// 0.005 no point of the half-plane is lower: certified to tau although the cells across
 /// x = 1.9 hold the box's minimum (they are split on x down to the cut's width, 0.01, where
 /// none reaches past 1.91, g >= 0.0081), and no node beyond the cut is taken as the best.
-/// Against 0.02 a node below it is found, on the searched side.
+/// At a resolution coarser than that width, the cells across the cut are bounded over their
+/// part in the half-plane ([`Bnb::clipped`]). Against 0.02 a node below it is found, on the
+/// searched side.
 #[test]
 fn a_search_restricted_to_a_half_plane_ignores_what_lies_beyond() {
     let tau = |_: f64| 1e-4;
@@ -424,6 +426,26 @@ fn a_search_restricted_to_a_half_plane_ignores_what_lies_beyond() {
             assert!(c.t1[0] - c.t0[0] <= 0.01, "{c:?}");
         }
     }
+    // With a resolution of 0.3 the cell across x = 1.9 stops at [1.75, 2] on x: bounded whole
+    // it holds x = 2 (0), and over its part x <= 1.9 alone (a row at 1.9) it clears the
+    // target: nothing is left to a polish.
+    let mut b = sparse_two_wells(false);
+    b.set_cut(Cut { width: 0.3, ..cut });
+    b.set_resolution([0.3, 0.3]);
+    b.start_on(&grid_cells(0..10), 0.005 - 1e-4);
+    b.refine(0.005, &tau, &|u| u);
+    let c = b.certificate(0.005);
+    assert!(
+        c.lowest >= 0.005 - 1e-4 && c.reasons.is_empty() && c.fine_cells == 0,
+        "{c:?}"
+    );
+    assert!(b.land.x.contains(&1.9), "{:?}", b.land.x);
+    assert!(
+        b.cells_below(f64::INFINITY)
+            .iter()
+            .any(|c| c.t0[0] == 1.75 && c.t1[0] == 2.0),
+        "the cell [1.75, 2] across the cut was not cleared"
+    );
     // Without the cut the same cells hold chi2 0 < 0.005.
     let mut b = sparse_two_wells(false);
     b.start_on(&grid_cells(0..10), 0.005 - 1e-4);
