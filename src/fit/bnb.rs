@@ -424,7 +424,13 @@ impl<L: Landscape> Bnb<L> {
         if let Some(&r) = self.axes[k].row_of.get(&p) {
             return r;
         }
-        let t = self.axes[k].t_at(p);
+        let r = self.add_row(k, self.axes[k].t_at(p));
+        self.axes[k].row_of.insert(p, r);
+        r
+    }
+
+    /// Tabulates axis k at t (a failure recorded, the row kept as failed); its row id.
+    fn add_row(&mut self, k: usize, t: f64) -> usize {
         let ok = match self.land.add_row(k, t) {
             Ok(()) => true,
             Err(why) => {
@@ -435,11 +441,9 @@ impl<L: Landscape> Bnb<L> {
             }
         };
         let a = &mut self.axes[k];
-        let r = a.t.len();
         a.t.push(t);
         a.ok.push(ok);
-        a.row_of.insert(p, r);
-        r
+        a.t.len() - 1
     }
 
     fn rows_total(&self) -> usize {
@@ -734,19 +738,7 @@ impl<L: Landscape> Bnb<L> {
         let r = match self.cut_row {
             Some(r) => r,
             None => {
-                let ok = match self.land.add_row(k.axis, k.at) {
-                    Ok(()) => true,
-                    Err(why) => {
-                        if self.row_failures.len() < 3 {
-                            self.row_failures.push(why);
-                        }
-                        false
-                    }
-                };
-                let a = &mut self.axes[k.axis];
-                let r = a.t.len();
-                a.t.push(k.at);
-                a.ok.push(ok);
+                let r = self.add_row(k.axis, k.at);
                 self.cut_row = Some(r);
                 r
             }
