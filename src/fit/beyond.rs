@@ -37,7 +37,10 @@ use super::lsq::{self, Residuals};
 use super::models::ModelKind;
 use super::objective::Objective;
 use super::profile::{Extension, Inner, Moved, Profiles, Side, extend_to_region};
-use super::search::{POWERLAW_N0, Region, SEPARABLE_N0, TAU_ABS, ToTheta, axes_of, tolerance};
+use super::search::{
+    POWERLAW_N0, Region, TAU_ABS, ToTheta, axes_of, powerlaw_range, powerlaw_theta, separable_grid,
+    theta_of, tolerance,
+};
 use super::sums;
 use crate::error::Result;
 use crate::models::viscoelastic::VmMethod;
@@ -160,17 +163,11 @@ pub fn beyond_end(
     match obj.kind {
         ModelKind::Vm | ModelKind::Pm | ModelKind::Min | ModelKind::Product => {
             let kind = obj.kind;
-            let active = [kind != ModelKind::Pm, kind != ModelKind::Vm];
+            let (active, range, n0) = separable_grid(obj);
             // The parameter's axis of the landscape (pm's sigma_y is axis 1).
             let axis = if kind == ModelKind::Pm { 1 } else { j };
             end_of.cut = Some((axis, at, dir));
             let land = Separable::new(obj, kind == ModelKind::Min, active).with_second_order();
-            let range = match kind {
-                ModelKind::Vm => [(obj.lower[0], obj.upper[0]), (0.0, 0.0)],
-                ModelKind::Pm => [(0.0, 0.0), (obj.lower[0], obj.upper[0])],
-                _ => [(obj.lower[0], obj.upper[0]), (obj.lower[1], obj.upper[1])],
-            };
-            let n0 = [0, 1].map(|k| if active[k] { SEPARABLE_N0[k] } else { 0 });
             let mut bnb = Bnb::sparse(land, range, n0, limits);
             bnb.set_cut(Cut {
                 axis,
@@ -178,22 +175,16 @@ pub fn beyond_end(
                 dir,
                 width: margin.max(region.resolution[axis]),
             });
-            let to_theta = move |_: &Separable, _: [usize; 2], t: [f64; 2]| match kind {
-                ModelKind::Vm => vec![t[0]],
-                ModelKind::Pm => vec![t[1]],
-                _ => vec![t[0], t[1]],
-            };
-            end_of.run(bnb, &to_theta)
+            end_of.run(bnb, &move |_: &Separable, _, t| theta_of(kind, t))
         }
         ModelKind::PowerLaw => {
             let mut land = PowerLaw::new(obj);
             land.bound_tol = 0.1 * TAU_ABS;
-            let range = [(obj.lower[1], obj.upper[1]), (obj.lower[2], obj.upper[2])];
             if j == 0 {
                 // A's half-plane is its range: the landscape minimises over it.
                 land.amplitude_range(clip.lower[0], clip.upper[0]);
             }
-            let mut bnb = Bnb::sparse(land, range, POWERLAW_N0, limits);
+            let mut bnb = Bnb::sparse(land, powerlaw_range(obj), POWERLAW_N0, limits);
             if j >= 1 {
                 end_of.cut = Some((j - 1, at, dir));
                 bnb.set_cut(Cut {
@@ -203,9 +194,7 @@ pub fn beyond_end(
                     width: margin.max(region.resolution[j - 1]),
                 });
             }
-            let to_theta =
-                |land: &PowerLaw, r: [usize; 2], t: [f64; 2]| vec![land.profile(r).0, t[0], t[1]];
-            end_of.run(bnb, &to_theta)
+            end_of.run(bnb, &powerlaw_theta)
         }
     }
 }

@@ -193,24 +193,12 @@ pub fn global_minimum(obj: &Objective, options: &FitOptions) -> Result<SearchOut
         max_cells: 200_000,
         max_rows: if ode { 400 } else { 40000 },
     };
-    let (el, eh) = (obj.lower[0], obj.upper[0]);
     match kind {
         ModelKind::Vm | ModelKind::Pm | ModelKind::Min | ModelKind::Product => {
-            let (sl, sh) = match kind {
-                ModelKind::Vm => (0.0, 0.0),
-                ModelKind::Pm => (obj.lower[0], obj.upper[0]),
-                _ => (obj.lower[1], obj.upper[1]),
-            };
-            let active = [kind != ModelKind::Pm, kind != ModelKind::Vm];
+            let (active, range, n0) = separable_grid(obj);
             let land = Separable::new(obj, kind == ModelKind::Min, active);
-            let range = [if active[0] { (el, eh) } else { (0.0, 0.0) }, (sl, sh)];
-            let n0 = [0, 1].map(|k| if active[k] { SEPARABLE_N0[k] } else { 0 });
             let bnb = Bnb::new(land, range, n0, limits);
-            let to_theta = move |_: &Separable, _: [usize; 2], t: [f64; 2]| match kind {
-                ModelKind::Vm => vec![t[0]],
-                ModelKind::Pm => vec![t[1]],
-                _ => vec![t[0], t[1]],
-            };
+            let to_theta = move |_: &Separable, _: [usize; 2], t: [f64; 2]| theta_of(kind, t);
             let polish = move |_: &Separable, c: &Candidate| -> Result<Found> {
                 if kind.n_params() == 2 {
                     return polish_lm(obj, &[c.t[0], c.t[1]]);
@@ -223,10 +211,8 @@ pub fn global_minimum(obj: &Objective, options: &FitOptions) -> Result<SearchOut
         ModelKind::PowerLaw => {
             let mut land = PowerLaw::new(obj);
             land.bound_tol = 0.1 * TAU_ABS;
-            let range = [(obj.lower[1], obj.upper[1]), (obj.lower[2], obj.upper[2])];
-            let bnb = Bnb::new(land, range, POWERLAW_N0, limits);
-            let to_theta =
-                |land: &PowerLaw, r: [usize; 2], t: [f64; 2]| vec![land.profile(r).0, t[0], t[1]];
+            let bnb = Bnb::new(land, powerlaw_range(obj), POWERLAW_N0, limits);
+            let to_theta = powerlaw_theta;
             // The profile over the exponents first, then all three parameters from there; the
             // lower of the two.
             let polish = |_: &PowerLaw, c: &Candidate| -> Result<Found> {
@@ -251,6 +237,44 @@ const RESOLUTION_1D: f64 = 0.25;
 
 /// Maps a landscape cell (grid indices and offsets) to the model's parameters.
 pub(crate) type ToTheta<'a, L> = &'a dyn Fn(&L, [usize; 2], [f64; 2]) -> Vec<f64>;
+
+/// The separable models' grid: which axes are parameters (e_vm's eta, e_pm's sigma_y), their
+/// ranges (the search box; an inactive axis one row at 0) and starting cells. Every branch and
+/// bound on a separable landscape of one fit takes it from here: the global search's region
+/// cells, as dyadic positions, mean the same cells in its slices ([`super::slice`]) and beyond
+/// its interval ends ([`super::beyond`]).
+pub(crate) fn separable_grid(obj: &Objective) -> ([bool; 2], [(f64, f64); 2], [u64; 2]) {
+    let kind = obj.kind;
+    let active = [kind != ModelKind::Pm, kind != ModelKind::Vm];
+    let range = match kind {
+        ModelKind::Vm => [(obj.lower[0], obj.upper[0]), (0.0, 0.0)],
+        ModelKind::Pm => [(0.0, 0.0), (obj.lower[0], obj.upper[0])],
+        _ => [(obj.lower[0], obj.upper[0]), (obj.lower[1], obj.upper[1])],
+    };
+    let n0 = [0, 1].map(|k| if active[k] { SEPARABLE_N0[k] } else { 0 });
+    (active, range, n0)
+}
+
+/// The power law's grid over its exponents (a, b) (the search box; starting cells
+/// [`POWERLAW_N0`]), as [`separable_grid`] for the separable models.
+pub(crate) fn powerlaw_range(obj: &Objective) -> [(f64, f64); 2] {
+    [(obj.lower[1], obj.upper[1]), (obj.lower[2], obj.upper[2])]
+}
+
+/// The parameters of a separable `kind` model at the landscape's coordinates `t` (the inverse
+/// of [`axes_of`]).
+pub(crate) fn theta_of(kind: ModelKind, t: [f64; 2]) -> Vec<f64> {
+    match kind {
+        ModelKind::Vm => vec![t[0]],
+        ModelKind::Pm => vec![t[1]],
+        _ => vec![t[0], t[1]],
+    }
+}
+
+/// The power law's parameters at a node of its landscape: A at its least-squares value there.
+pub(crate) fn powerlaw_theta(land: &PowerLaw, r: [usize; 2], t: [f64; 2]) -> Vec<f64> {
+    vec![land.profile(r).0, t[0], t[1]]
+}
 
 /// The coordinates on the branch and bound's axes of the parameters `th` of a `kind` model (its
 /// landscape's: e_vm's eta and e_pm's sigma_y, or the power law's exponents).

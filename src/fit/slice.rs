@@ -43,7 +43,9 @@ use super::models::ModelKind;
 use super::objective::Objective;
 use super::powerlaw::ProfiledPowerLaw;
 use super::scalar;
-use super::search::{POWERLAW_N0, Region, SEPARABLE_N0, TAU_ABS, tolerance};
+use super::search::{
+    POWERLAW_N0, Region, SEPARABLE_N0, TAU_ABS, powerlaw_range, separable_grid, tolerance,
+};
 use crate::error::Result;
 use crate::models::viscoelastic::VmMethod;
 
@@ -98,7 +100,7 @@ pub fn slice_minimum(
                 th
             };
             let land = Separable::new(obj, obj.kind == ModelKind::Min, [true, true]);
-            let box_ = [(obj.lower[0], obj.upper[0]), (obj.lower[1], obj.upper[1])];
+            let box_ = separable_grid(obj).1;
             let chi2 = |x: f64| lsq::chi2(obj, &at(x));
             slice
                 .on(land, [j, o], box_, SEPARABLE_N0, o, &at, &chi2)
@@ -116,7 +118,7 @@ pub fn slice_minimum(
             };
             let mut land = PowerLaw::new(obj);
             land.bound_tol = 0.1 * TAU_ABS;
-            let box_ = [(obj.lower[1], obj.upper[1]), (obj.lower[2], obj.upper[2])];
+            let box_ = powerlaw_range(obj);
             let chi2 = |x: f64| lsq::chi2(obj, &at(x));
             slice
                 .on(land, [h, o], box_, POWERLAW_N0, o + 1, &at, &chi2)
@@ -128,7 +130,7 @@ pub fn slice_minimum(
             let mut land = PowerLaw::new(obj);
             land.bound_tol = 0.1 * TAU_ABS;
             land.hold_amplitude(t);
-            let box_ = [(obj.lower[1], obj.upper[1]), (obj.lower[2], obj.upper[2])];
+            let box_ = powerlaw_range(obj);
             slice.held_amplitude(land, box_).map(Some)
         }
         _ => Ok(None),
