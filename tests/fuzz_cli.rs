@@ -226,7 +226,11 @@ fn fig7_rows_distinct(n: usize) -> Vec<u8> {
 /// CPU together, less the rows they share (3.7-4.0 s on the two cores, 2.0-2.3 s of wall
 /// time). On the faster 2 Intel Xeon cores of 2026-11-27: 0.2 s (`vm`, `pm`), 0.6 s (`min`),
 /// 0.9 s (`product`, `powerlaw`), and `--model all` 2.2-2.3 s of CPU, 1.2 s of wall time:
-/// beyond the limit, so not a case here (README, known limitations).
+/// beyond the limit, so not a case here (README, known limitations). On 2026-11-28, with the
+/// profiles' global inner minimisation and the search beyond each interval end, on these rows
+/// (two runs each): 0.2-0.3 s (`vm`, `pm`), 0.75-0.84 s (`min`), 1.0 s (`product`), 1.4-1.7 s
+/// (`powerlaw`, three runs; b0aab52 1.2-1.5 s): the thinnest margin, and `--model all`
+/// 3.1 s of CPU, 1.7 s of wall time.
 #[test]
 fn hundred_thousand_rows_fit() {
     let mut cases = Vec::new();
