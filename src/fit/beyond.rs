@@ -152,13 +152,19 @@ pub fn beyond_end(
     } else {
         clip.lower[j] = at;
     }
-    let mut end_of = Search {
+    let end_of = Search {
         obj,
         clip: &clip,
         threshold,
         region,
         limits,
-        cut: None,
+    };
+    // A cell across the cut is split on its axis down to the margin or the search's resolution.
+    let cut = |axis: usize| Cut {
+        axis,
+        at,
+        dir,
+        width: margin.max(region.resolution[axis]),
     };
     match obj.kind {
         ModelKind::Vm | ModelKind::Pm | ModelKind::Min | ModelKind::Product => {
@@ -166,15 +172,9 @@ pub fn beyond_end(
             let (active, range, n0) = separable_grid(obj);
             // The parameter's axis of the landscape (pm's sigma_y is axis 1).
             let axis = if kind == ModelKind::Pm { 1 } else { j };
-            end_of.cut = Some((axis, at, dir));
             let land = Separable::new(obj, kind == ModelKind::Min, active).with_second_order();
             let mut bnb = Bnb::sparse(land, range, n0, limits);
-            bnb.set_cut(Cut {
-                axis,
-                at,
-                dir,
-                width: margin.max(region.resolution[axis]),
-            });
+            bnb.set_cut(cut(axis));
             end_of.run(bnb, &move |_: &Separable, _, t| theta_of(kind, t))
         }
         ModelKind::PowerLaw => {
@@ -186,13 +186,7 @@ pub fn beyond_end(
             }
             let mut bnb = Bnb::sparse(land, powerlaw_range(obj), POWERLAW_N0, limits);
             if j >= 1 {
-                end_of.cut = Some((j - 1, at, dir));
-                bnb.set_cut(Cut {
-                    axis: j - 1,
-                    at,
-                    dir,
-                    width: margin.max(region.resolution[j - 1]),
-                });
+                bnb.set_cut(cut(j - 1));
             }
             end_of.run(bnb, &powerlaw_theta)
         }
@@ -206,8 +200,6 @@ struct Search<'a> {
     threshold: f64,
     region: &'a Region,
     limits: Limits,
-    /// The cut as (axis, at, dir), None for the power law's A (its range is the cut).
-    cut: Option<(usize, f64, f64)>,
 }
 
 impl Search<'_> {
@@ -217,18 +209,9 @@ impl Search<'_> {
         let (obj, threshold) = (self.obj, self.threshold);
         let tau_of = |u: f64| tolerance(obj, u);
         let tau = tau_of(threshold);
-        // The region's cells with a point beyond the cut (its edge on `at` belongs to cells
-        // beyond as well).
+        // The region's cells with a point beyond the cut.
         let cells: Vec<([u64; 2], [u64; 2])> = (self.region.cells.iter())
-            .filter(|c| {
-                self.cut.is_none_or(|(k, at, dir)| {
-                    if dir > 0.0 {
-                        c.t1[k] > at
-                    } else {
-                        c.t0[k] < at
-                    }
-                })
-            })
+            .filter(|c| bnb.reaches_cut(c))
             .map(|c| (c.p0, c.p1))
             .collect();
         if cells.len() > self.limits.max_cells as usize {

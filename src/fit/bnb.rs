@@ -200,6 +200,16 @@ impl Cut {
     fn keeps(&self, t: f64) -> bool {
         (t - self.at) * self.dir >= 0.0
     }
+
+    /// Whether a cell spanning `t0 ..= t1` on the cut's axis has a point in the half-plane, not
+    /// counting an edge on `at` (it belongs to a cell beyond too).
+    fn reaches(&self, t0: f64, t1: f64) -> bool {
+        if self.dir > 0.0 {
+            t1 > self.at
+        } else {
+            t0 < self.at
+        }
+    }
 }
 
 /// Budgets of a [`Bnb`].
@@ -696,13 +706,20 @@ impl<L: Landscape> Bnb<L> {
     }
 
     /// Whether some point of the cell lies in the cut's half-plane (all, without a cut), not
-    /// counting an edge on the cut's `at` (it belongs to a cell beyond too).
+    /// counting an edge on the cut's `at` ([`Cut::reaches`]).
     fn within_cut(&self, c: &Cell) -> bool {
         self.cut.is_none_or(|k| {
             let a = &self.axes[k.axis];
-            let (t0, t1) = (a.t_at(c.p0[k.axis]), a.t_at(c.p1[k.axis]));
-            if k.dir > 0.0 { t1 > k.at } else { t0 < k.at }
+            k.reaches(a.t_at(c.p0[k.axis]), a.t_at(c.p1[k.axis]))
         })
+    }
+
+    /// Whether a cell of another branch and bound on the same grid has a point in the cut's
+    /// half-plane (a region's, before starting on it: [`Bnb::start_on`] bounds every cell it is
+    /// given).
+    pub fn reaches_cut(&self, c: &CellBox) -> bool {
+        self.cut
+            .is_none_or(|k| k.reaches(c.t0[k.axis], c.t1[k.axis]))
     }
 
     /// A cell at the resolution across the cut's `at`, bounded over its part in the half-plane
