@@ -11,10 +11,13 @@
 //! profile passes the threshold or the search box ends (an open side: the parameter is a bound);
 //! then the crossing by Brent's root finder ([`super::scalar::profile_crossing`]). The inner
 //! minimisation is Levenberg-Marquardt warm-started from the nearest profile point already
-//! computed, so a profile follows its valley; where its value is at or above the threshold, an
+//! computed, so a profile follows its valley. Where its value is at or above the threshold, an
 //! [`Inner`] given (the fit's, for `min`, `product` and the power law:
 //! [`super::slice`]) shows it is the profile's or finds a lower point (a value below the
-//! threshold needs no check: the profile is at most that). [`extend_to_region`] then moves an end past any known point of the 95% region
+//! threshold needs no check: the profile is at most that): at the first such point of each
+//! crossing's search (where its steps outwards stopped) and at the outer end of its root
+//! finder's last bracket, the point the end rests on; where it finds that point below the
+//! threshold, the crossing is searched again from there (see `profile_end`). [`extend_to_region`] then moves an end past any known point of the 95% region
 //! beyond it (the interval is the hull of the region found). A profile point below the minimum
 //! reveals a lower minimum: the caller refits from it. Every failure is a value: a side whose crossing could
 //! not be found is [`Side::Lost`] with the reason, and inner minimisations that did not converge
@@ -160,9 +163,33 @@ enum End {
     Lower(Vec<f64>),
 }
 
+/// Rounds of a profile end whose crossing's outer point the inner search put below the
+/// threshold, with the inner search left to two points per crossing; then it runs at every
+/// point at or above the threshold.
+const LAZY_ROUNDS: usize = 3;
+
+/// A profile point: t, where the inner minimisation ended, its chi2, and whether the local
+/// minimisation converged.
+type Point = (f64, Vec<f64>, f64, bool);
+
 /// The end `s` (0 lower, 1 upper) of parameter j's interval (see the module doc), searched
 /// outwards from `from` = (theta, chi2), a point below the threshold chi2_min + delta: the
 /// minimum, or a point of the 95% region beyond an end already found ([`extend_to_region`]).
+///
+/// The global inner minimisation (`inner`) runs at two points per crossing: the first point
+/// whose local value is at or above the threshold (where the steps outwards stopped; a part of
+/// the region the local minimisation missed is most often found there), and the outer end of
+/// the root finder's last bracket, the innermost such point, which the end rests on (every
+/// point of a crossing's search at or above the threshold lies beyond every point below it: the
+/// steps go outwards until one is above, and the brackets shrink). A local value below the
+/// threshold shows the profile below it (the profile is at most that), so the bracket's inner
+/// end needs no check. Where the inner search puts the outer end below the threshold after
+/// all, the crossing is searched again outwards from there, the warm starts beginning at the
+/// point it found (a part of the region the local minimisation missed), LAZY_ROUNDS times, then
+/// with the inner search at every point at or above the threshold. Why: running it at every
+/// such point cost two to five inner searches per end where two decide (`min` and `product`
+/// on 100 000 points of distinct sizes: the crossings' root finding probes a flat profile
+/// near sigma_y's plateau several times from above).
 fn profile_end(
     obj: &impl Residuals,
     from: (&[f64], f64),
@@ -191,13 +218,51 @@ fn profile_end(
         0.01 * span
     };
     let limit = [lower[j], upper[j]][s];
+    let dir = if s == 0 { -1.0 } else { 1.0 };
     let failed_inner = Cell::new(0u32);
     let warm = RefCell::new(vec![(theta[j], theta.to_vec())]);
     let lower_found = RefCell::new(None::<Vec<f64>>);
-    let profile = |t: f64| -> Result<f64> {
+    // The inner search at every point at or above the threshold (after LAZY_ROUNDS rounds).
+    let eager = Cell::new(false);
+    // Whether a round started from a point the inner search found (its valley, not the local
+    // minimisation's: the warm starts begin again there).
+    let restarted = Cell::new(false);
+    // Whether the round's first point at or above the threshold (where its steps outwards
+    // stopped) has been seen.
+    let stepped = Cell::new(false);
+    // The points of the current round's crossing whose local value is at or above the
+    // threshold, not yet checked by the inner search.
+    let unchecked = RefCell::new(Vec::<Point>::new());
+    let found = |c: f64, th: &Vec<f64>| {
+        if c < beaten && lower_found.borrow().is_none() {
+            *lower_found.borrow_mut() = Some(th.clone());
+        }
+    };
+    // The inner search at a point whose local value is at or above the threshold: its value
+    // and point (the local ones where it does not cover the parameter).
+    let global = |(t, th, c, converged): Point| -> Result<(f64, Vec<f64>)> {
+        let g = inner.expect("only called with an inner search");
+        Ok(match g(j, t, (&th, c, converged), threshold)? {
+            Some((th, c, shown)) => {
+                if !shown {
+                    failed_inner.set(failed_inner.get() + 1);
+                }
+                (c, th)
+            }
+            None => {
+                if !converged {
+                    failed_inner.set(failed_inner.get() + 1);
+                }
+                (c, th)
+            }
+        })
+    };
+    let mut profile = |t: f64| -> Result<f64> {
         let mut start = match &warm.borrow()[..] {
             // Only the minimum so far: along the covariance's valley (exact for a quadratic).
-            [_] => along_covariance(theta, cov, j, t, lower, upper),
+            [_] if !restarted.get() => along_covariance(theta, cov, j, t, lower, upper),
+            // Only the point a new round starts from: from there.
+            [(_, th)] => Some(th.clone()),
             w => warm_start(w, t, lower, upper),
         }
         .unwrap_or_else(|| theta.to_vec());
@@ -208,37 +273,56 @@ fn profile_end(
             let mut free = vec![true; k];
             free[j] = false;
             let r = lsq::levenberg_marquardt(obj, &start, &free, &lm)?;
-            // Where the local value is below the threshold so is the profile's (it is at most
-            // that); above it, whether the profile is too must be shown.
-            let global = match inner {
-                Some(g) if !(r.chi2 < threshold) => {
-                    g(j, t, (&r.theta, r.chi2, r.converged), threshold)?
+            if r.chi2 < threshold || inner.is_none() {
+                // Below the threshold the profile is too (it is at most this value), converged
+                // or not; without an inner search the local value stands.
+                if !r.converged {
+                    failed_inner.set(failed_inner.get() + 1);
                 }
-                _ => None,
-            };
-            match global {
-                Some((th, c, shown)) => {
-                    if !shown {
-                        failed_inner.set(failed_inner.get() + 1);
-                    }
-                    (c, th)
-                }
-                None => {
-                    if !r.converged {
-                        failed_inner.set(failed_inner.get() + 1);
-                    }
-                    (r.chi2, r.theta)
-                }
+                (r.chi2, r.theta)
+            } else if eager.get() || !stepped.replace(true) {
+                global((t, r.theta, r.chi2, r.converged))?
+            } else {
+                unchecked
+                    .borrow_mut()
+                    .push((t, r.theta.clone(), r.chi2, r.converged));
+                (r.chi2, r.theta)
             }
         };
-        if c < beaten && lower_found.borrow().is_none() {
-            *lower_found.borrow_mut() = Some(th.clone());
-        }
+        found(c, &th);
         warm.borrow_mut().push((t, th));
         Ok(c)
     };
-    // Crossings to 1e-7 in the internal coordinate (log parameters: 1e-7 relative).
-    let c = profile_crossing(profile, theta[j], chi2_from, limit, step, threshold, 1e-7)?;
+    let (mut t0, mut v0) = (theta[j], chi2_from);
+    let mut round = 0;
+    let c = loop {
+        // Crossings to 1e-7 in the internal coordinate (log parameters: 1e-7 relative).
+        let c = profile_crossing(&mut profile, t0, v0, limit, step, threshold, 1e-7)?;
+        let outer = std::mem::take(&mut *unchecked.borrow_mut())
+            .into_iter()
+            .min_by(|a, b| ((a.0 - t0) * dir).total_cmp(&((b.0 - t0) * dir)));
+        let (Crossing::At(_), Some(outer), false) = (&c, outer, lower_found.borrow().is_some())
+        else {
+            break c;
+        };
+        let t = outer.0;
+        let (v, th) = global(outer)?;
+        found(v, &th);
+        if !(v < threshold) || lower_found.borrow().is_some() {
+            break c;
+        }
+        // The outer end is below the threshold: the crossing lies beyond it, and the profile
+        // follows the valley the inner search found there (warm starts from the points before,
+        // in the valley the local minimisation followed, would lead back into it).
+        *warm.borrow_mut() = vec![(t, th)];
+        restarted.set(true);
+        stepped.set(false);
+        (t0, v0) = (t, v);
+        round += 1;
+        if round >= LAZY_ROUNDS {
+            eager.set(true);
+        }
+    };
     if let Some(t) = lower_found.into_inner() {
         return Ok(End::Lower(t));
     }
@@ -490,6 +574,105 @@ mod tests {
         let mut p = intervals(&problem);
         extend_to_region(&problem, 0.0, &cov, &mut p, &inside, None).unwrap();
         assert_eq!(p.sides[0][1], Side::Open);
+    }
+
+    /// chi2(t, x) = min over k < valleys of 0.5 k + (t / (1 + k))^2 + (x - 5 k)^2: valleys in
+    /// x five apart (ridges between them), each shallower in t than the one before. The profile
+    /// over t is min_k (0.5 k + (t / (1 + k))^2), which reaches 3.84 at the largest of
+    /// (1 + k) sqrt(3.84 - 0.5 k); Levenberg-Marquardt over x, started in valley 0, stays there
+    /// and crosses at 1.96.
+    struct Valleys {
+        valleys: usize,
+    }
+
+    impl Valleys {
+        fn best(&self, t: f64, x: f64) -> (f64, [f64; 3]) {
+            (0..self.valleys)
+                .map(|k| {
+                    let k = k as f64;
+                    let r = [(0.5 * k).sqrt(), t / (1.0 + k), x - 5.0 * k];
+                    (r.iter().map(|v| v * v).sum::<f64>(), r)
+                })
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+                .expect("a valley")
+        }
+
+        /// The end of the profile's interval: the largest valley crossing.
+        fn end(&self) -> f64 {
+            (0..self.valleys)
+                .map(|k| (1.0 + k as f64) * (CHI2_1DOF_95 - 0.5 * k as f64).sqrt())
+                .fold(f64::NEG_INFINITY, f64::max)
+        }
+    }
+
+    impl Residuals for Valleys {
+        fn n_params(&self) -> usize {
+            2
+        }
+        fn n_residuals(&self) -> usize {
+            3
+        }
+        fn residuals(&self, th: &[f64], out: &mut [f64]) -> Result<()> {
+            out.copy_from_slice(&self.best(th[0], th[1]).1);
+            Ok(())
+        }
+        fn lower(&self) -> &[f64] {
+            &[-20.0, -50.0]
+        }
+        fn upper(&self) -> &[f64] {
+            &[20.0, 50.0]
+        }
+        fn fd_step(&self) -> f64 {
+            1e-7
+        }
+    }
+
+    /// Where the local minimisation crosses the threshold in the wrong valley, the inner search
+    /// finds the point below it, and the crossing is searched again from there, ending at the
+    /// profile's own crossing; the inner search runs at most twice per crossing, not at every
+    /// point at or above the threshold.
+    #[test]
+    fn the_inner_search_checks_each_crossings_outer_point_and_the_profile_goes_on_from_there() {
+        let cov = Covariance {
+            matrix: nalgebra::DMatrix::identity(2, 2),
+            no_effect: vec![false; 2],
+            degenerate: vec![false; 2],
+        };
+        // The inner search at every point at or above the threshold made 1, 4 and 4 calls.
+        for (valleys, most_calls) in [(1, 1), (2, 2), (6, 2)] {
+            let problem = Valleys { valleys };
+            let calls = std::sync::atomic::AtomicUsize::new(0);
+            // The global minimum over x at t (the valleys' floors, x = 5 k), shown.
+            let inner = |j: usize, t: f64, _: (&[f64], f64, bool), _: f64| {
+                assert_eq!(j, 0, "only t is profiled here");
+                calls.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let (c, k) = (0..problem.valleys)
+                    .map(|k| (problem.best(t, 5.0 * k as f64).0, k))
+                    .min_by(|a, b| a.0.total_cmp(&b.0))
+                    .expect("a valley");
+                Ok(Some((vec![t, 5.0 * k as f64], c, true)))
+            };
+            let at = Around {
+                chi2_min: 0.0,
+                cov: &cov,
+                delta: CHI2_1DOF_95,
+                inner: Some(&inner),
+            };
+            let End::Side(Side::At(end), failed) =
+                profile_end(&problem, (&[0.0, 0.0], 0.0), &at, 0, 1).unwrap()
+            else {
+                panic!("{valleys} valleys: an end");
+            };
+            // Crossings are found to 1e-7 in t.
+            assert!(
+                (end - problem.end()).abs() < 1e-6,
+                "{valleys} valleys: {end} against {}",
+                problem.end()
+            );
+            assert_eq!(failed, 0);
+            let n = calls.into_inner();
+            assert!(n <= most_calls, "{valleys} valleys: {n} inner searches");
+        }
     }
 
     #[test]
