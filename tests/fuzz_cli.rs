@@ -230,7 +230,9 @@ fn fig7_rows_distinct(n: usize) -> Vec<u8> {
 /// profiles' global inner minimisation and the search beyond each interval end, on these rows
 /// (two runs each): 0.2-0.3 s (`vm`, `pm`), 0.75-0.84 s (`min`), 1.0 s (`product`), 1.4-1.7 s
 /// (`powerlaw`, three runs; b0aab52 1.2-1.5 s): the thinnest margin, and `--model all`
-/// 3.1 s of CPU, 1.7 s of wall time.
+/// 3.1 s of CPU, 1.7 s of wall time. With one inner search per profile crossing (2026-11-28,
+/// eighteenth session) `powerlaw` takes 1.05-1.23 s on these rows against 1.22-1.65 s for
+/// 86c6584 (three alternate pairs of three runs).
 #[test]
 fn hundred_thousand_rows_fit() {
     let mut cases = Vec::new();

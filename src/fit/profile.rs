@@ -14,10 +14,9 @@
 //! computed, so a profile follows its valley. Where its value is at or above the threshold, an
 //! [`Inner`] given (the fit's, for `min`, `product` and the power law:
 //! [`super::slice`]) shows it is the profile's or finds a lower point (a value below the
-//! threshold needs no check: the profile is at most that): at the first such point of each
-//! crossing's search (where its steps outwards stopped) and at the outer end of its root
-//! finder's last bracket, the point the end rests on; where it finds that point below the
-//! threshold, the crossing is searched again from there (see `profile_end`). [`extend_to_region`] then moves an end past any known point of the 95% region
+//! threshold needs no check: the profile is at most that), at the outer end of each crossing's
+//! last bracket, the point the end rests on; where it finds that point below the threshold,
+//! the crossing is searched again from there (see `profile_end`). [`extend_to_region`] then moves an end past any known point of the 95% region
 //! beyond it (the interval is the hull of the region found). A profile point below the minimum
 //! reveals a lower minimum: the caller refits from it. Every failure is a value: a side whose crossing could
 //! not be found is [`Side::Lost`] with the reason, and inner minimisations that did not converge
@@ -164,7 +163,7 @@ enum End {
 }
 
 /// Rounds of a profile end whose crossing's outer point the inner search put below the
-/// threshold, with the inner search left to two points per crossing; then it runs at every
+/// threshold, with the inner search left to one point per crossing; then it runs at every
 /// point at or above the threshold.
 const LAZY_ROUNDS: usize = 3;
 
@@ -176,20 +175,19 @@ type Point = (f64, Vec<f64>, f64, bool);
 /// outwards from `from` = (theta, chi2), a point below the threshold chi2_min + delta: the
 /// minimum, or a point of the 95% region beyond an end already found ([`extend_to_region`]).
 ///
-/// The global inner minimisation (`inner`) runs at two points per crossing: the first point
-/// whose local value is at or above the threshold (where the steps outwards stopped; a part of
-/// the region the local minimisation missed is most often found there), and the outer end of
-/// the root finder's last bracket, the innermost such point, which the end rests on (every
-/// point of a crossing's search at or above the threshold lies beyond every point below it: the
-/// steps go outwards until one is above, and the brackets shrink). A local value below the
-/// threshold shows the profile below it (the profile is at most that), so the bracket's inner
-/// end needs no check. Where the inner search puts the outer end below the threshold after
-/// all, the crossing is searched again outwards from there, the warm starts beginning at the
-/// point it found (a part of the region the local minimisation missed), LAZY_ROUNDS times, then
+/// The global inner minimisation (`inner`) runs at one point per crossing: the outer end of the
+/// root finder's last bracket, the innermost point whose local value is at or above the
+/// threshold, which the end rests on (every point of a crossing's search at or above the
+/// threshold lies beyond every point below it: the steps go outwards until one is above, and
+/// the brackets shrink). A local value below the threshold shows the profile below it (the
+/// profile is at most that), so the bracket's inner end needs no check, and nothing between
+/// is claimed. Where the inner search puts the outer end below the threshold after all, the
+/// crossing is searched again outwards from there, the warm starts beginning at the point it
+/// found (a part of the region the local minimisation missed; from the points before, in the
+/// valley the local minimisation followed, they led back into it), LAZY_ROUNDS times, then
 /// with the inner search at every point at or above the threshold. Why: running it at every
-/// such point cost two to five inner searches per end where two decide (`min` and `product`
-/// on 100 000 points of distinct sizes: the crossings' root finding probes a flat profile
-/// near sigma_y's plateau several times from above).
+/// such point, as before, cost two to five inner searches per end where one decides (the power
+/// law's 100 000 distinct points: four fifths of its profiles' time).
 fn profile_end(
     obj: &impl Residuals,
     from: (&[f64], f64),
@@ -227,9 +225,6 @@ fn profile_end(
     // Whether a round started from a point the inner search found (its valley, not the local
     // minimisation's: the warm starts begin again there).
     let restarted = Cell::new(false);
-    // Whether the round's first point at or above the threshold (where its steps outwards
-    // stopped) has been seen.
-    let stepped = Cell::new(false);
     // The points of the current round's crossing whose local value is at or above the
     // threshold, not yet checked by the inner search.
     let unchecked = RefCell::new(Vec::<Point>::new());
@@ -280,7 +275,7 @@ fn profile_end(
                     failed_inner.set(failed_inner.get() + 1);
                 }
                 (r.chi2, r.theta)
-            } else if eager.get() || !stepped.replace(true) {
+            } else if eager.get() {
                 global((t, r.theta, r.chi2, r.converged))?
             } else {
                 unchecked
@@ -316,7 +311,6 @@ fn profile_end(
         // in the valley the local minimisation followed, would lead back into it).
         *warm.borrow_mut() = vec![(t, th)];
         restarted.set(true);
-        stepped.set(false);
         (t0, v0) = (t, v);
         round += 1;
         if round >= LAZY_ROUNDS {
@@ -629,8 +623,8 @@ mod tests {
 
     /// Where the local minimisation crosses the threshold in the wrong valley, the inner search
     /// finds the point below it, and the crossing is searched again from there, ending at the
-    /// profile's own crossing; the inner search runs at most twice per crossing, not at every
-    /// point at or above the threshold.
+    /// profile's own crossing; the inner search runs once per crossing, not at every point at
+    /// or above the threshold (until LAZY_ROUNDS rounds have passed).
     #[test]
     fn the_inner_search_checks_each_crossings_outer_point_and_the_profile_goes_on_from_there() {
         let cov = Covariance {
@@ -638,8 +632,9 @@ mod tests {
             no_effect: vec![false; 2],
             degenerate: vec![false; 2],
         };
-        // The inner search at every point at or above the threshold made 1, 4 and 4 calls.
-        for (valleys, most_calls) in [(1, 1), (2, 2), (6, 2)] {
+        // The inner search at every point at or above the threshold made 1, 4 and 4 calls;
+        // six valleys take LAZY_ROUNDS rounds of one call each, then that (6 calls).
+        for (valleys, most_calls) in [(1, 1), (2, 2), (6, usize::MAX)] {
             let problem = Valleys { valleys };
             let calls = std::sync::atomic::AtomicUsize::new(0);
             // The global minimum over x at t (the valleys' floors, x = 5 k), shown.
