@@ -220,11 +220,10 @@ fn profile_end(
     let failed_inner = Cell::new(0u32);
     let warm = RefCell::new(vec![(theta[j], theta.to_vec())]);
     let lower_found = RefCell::new(None::<Vec<f64>>);
-    // The inner search at every point at or above the threshold (after LAZY_ROUNDS rounds).
-    let eager = Cell::new(false);
-    // Whether a round started from a point the inner search found (its valley, not the local
-    // minimisation's: the warm starts begin again there).
-    let restarted = Cell::new(false);
+    // Rounds started again from a point the inner search found (its valley, not the local
+    // minimisation's: the warm starts begin again there); from LAZY_ROUNDS on, the inner
+    // search runs at every point at or above the threshold.
+    let rounds = Cell::new(0usize);
     // The points of the current round's crossing whose local value is at or above the
     // threshold, not yet checked by the inner search.
     let unchecked = RefCell::new(Vec::<Point>::new());
@@ -255,7 +254,7 @@ fn profile_end(
     let mut profile = |t: f64| -> Result<f64> {
         let mut start = match &warm.borrow()[..] {
             // Only the minimum so far: along the covariance's valley (exact for a quadratic).
-            [_] if !restarted.get() => along_covariance(theta, cov, j, t, lower, upper),
+            [_] if rounds.get() == 0 => along_covariance(theta, cov, j, t, lower, upper),
             // Only the point a new round starts from: from there.
             [(_, th)] => Some(th.clone()),
             w => warm_start(w, t, lower, upper),
@@ -275,7 +274,7 @@ fn profile_end(
                     failed_inner.set(failed_inner.get() + 1);
                 }
                 (r.chi2, r.theta)
-            } else if eager.get() {
+            } else if rounds.get() >= LAZY_ROUNDS {
                 global((t, r.theta, r.chi2, r.converged))?
             } else {
                 unchecked
@@ -289,7 +288,6 @@ fn profile_end(
         Ok(c)
     };
     let (mut t0, mut v0) = (theta[j], chi2_from);
-    let mut round = 0;
     let c = loop {
         // Crossings to 1e-7 in the internal coordinate (log parameters: 1e-7 relative).
         let c = profile_crossing(&mut profile, t0, v0, limit, step, threshold, 1e-7)?;
@@ -310,12 +308,8 @@ fn profile_end(
         // follows the valley the inner search found there (warm starts from the points before,
         // in the valley the local minimisation followed, would lead back into it).
         *warm.borrow_mut() = vec![(t, th)];
-        restarted.set(true);
+        rounds.set(rounds.get() + 1);
         (t0, v0) = (t, v);
-        round += 1;
-        if round >= LAZY_ROUNDS {
-            eager.set(true);
-        }
     };
     if let Some(t) = lower_found.into_inner() {
         return Ok(End::Lower(t));
