@@ -8,10 +8,13 @@
 //! - every row split into two rows e - d and e + d with error sqrt(2) sigma: the same parameters
 //!   as the original rows, chi2 larger by the constant sum (2 d^2 / (2 sigma^2)) = sum d^2/sigma^2.
 //!
-//! Tolerances: the parameters 1e-7 relative (the polish stops at a relative chi2 change of
-//! about 1e-12 and the parameters' own tolerance of 1e-10; merged and unmerged runs take different
-//! floating-point paths to the same minimum, and 1e-7 leaves room for a flat valley); chi2 1e-9
-//! relative (the minimum's value is insensitive to first order in the parameters).
+//! Tolerances: the parameters 4 sqrt(0.01 tau) of their standard error (tau the search's
+//! tolerance in chi2; merged and unmerged runs take different floating-point paths to the same
+//! minimum, and the two-parameter polishes stop where the Gauss-Newton step promises less than
+//! 0.01 tau: each run's chi2 that close to the minimum, its parameters within sqrt(0.01 tau)
+//! standard errors of it; two runs, and a factor 2 for the models' curvature); a parameter
+//! without a standard error (a bound) 1e-7 relative; chi2 1e-9 relative (the minimum's value is
+//! insensitive to first order in the parameters).
 
 use restitution::contact::Material;
 use restitution::fit::{FitData, FitOptions, ModelKind, Observation, fit};
@@ -42,13 +45,22 @@ fn rel(a: f64, b: f64) -> f64 {
 
 fn assert_same_params(a: &restitution::fit::FitResult, b: &restitution::fit::FitResult) {
     for (p, q) in a.params.iter().zip(&b.params) {
+        // Each run's chi2 within 0.01 tau of the minimum, so its parameters within
+        // sqrt(0.01 tau) standard errors (error bars as given); both runs, and a factor 2 for the
+        // models' curvature.
+        let tau = a.global.tolerance_chi2.max(b.global.tolerance_chi2);
+        let close = match p.stderr_abs {
+            Some(sd) => (p.best_fit - q.best_fit).abs() <= 4.0 * (0.01 * tau).sqrt() * sd,
+            None => rel(p.best_fit, q.best_fit) < 1e-7,
+        };
         assert!(
-            rel(p.best_fit, q.best_fit) < 1e-7,
-            "{} {}: {} vs {}",
+            close,
+            "{} {}: {} vs {} (standard error {:?})",
             a.model.name(),
             p.key,
             p.best_fit,
-            q.best_fit
+            q.best_fit,
+            p.stderr_abs
         );
     }
 }

@@ -108,6 +108,9 @@ impl Residuals for Clipped<'_> {
     ) -> Option<Result<()>> {
         self.obj.residuals_and_jacobian(theta, out, free, jac)
     }
+    fn kinked(&self) -> bool {
+        self.obj.kinked()
+    }
 }
 
 /// Whether the 95% region of `obj`'s parameter j has a part beyond `end` (side `s`: 0 below,

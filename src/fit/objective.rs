@@ -114,6 +114,9 @@ impl Residuals for Objective<'_> {
             _ => None,
         }
     }
+    fn kinked(&self) -> bool {
+        self.kind == ModelKind::Min
+    }
     fn residuals_and_jacobian(
         &self,
         theta: &[f64],
