@@ -253,6 +253,30 @@ pub struct Evaluator<'a> {
     kappa_per_eta_in_order: Vec<f64>,
     /// The rows of e_vm and e_pm the global searches asked for ([`Evaluator::row`]).
     rows: RowMemo,
+    /// The last rows of a held factor ([`Evaluator::held_row`]).
+    held: HeldRows,
+}
+
+/// The last [`HELD_ROWS`] rows of e_vm (axis 0, by the bits of eta) and of e_pm (axis 1, by the
+/// bits of sigma_y) held by a profile's inner fits, most recent last ([`Evaluator::held_row`]).
+/// A clone starts empty.
+#[derive(Default)]
+struct HeldRows(Mutex<Vec<(RowKey, Arc<Vec<f64>>)>>);
+
+/// Rows kept by [`HeldRows`]: the profile ends of `min` and `product` run side by side, two
+/// with each parameter held, so eight rows serve both models' ends at once.
+pub(super) const HELD_ROWS: usize = 8;
+
+impl Clone for HeldRows {
+    fn clone(&self) -> Self {
+        HeldRows::default()
+    }
+}
+
+impl fmt::Debug for HeldRows {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str("HeldRows")
+    }
 }
 
 /// Rows of e_vm (axis 0) and e_pm (axis 1) over every point, by axis and the bits of the log
@@ -306,6 +330,7 @@ impl<'a> Evaluator<'a> {
             kappa_order: Vec::new(),
             kappa_per_eta_in_order: Vec::new(),
             rows: RowMemo::default(),
+            held: HeldRows::default(),
         };
         if method == VmMethod::Master {
             let kpe = &ev.kappa_per_eta;
@@ -521,6 +546,42 @@ impl<'a> Evaluator<'a> {
             }
             row
         })
+    }
+
+    /// The row of e_vm at `x` = eta (axis 0) or of e_pm at `x` = sigma_y (axis 1) over every
+    /// point, the same doubles as the evaluations compute point by point, kept among the last
+    /// [`HELD_ROWS`] asked for; None where the model cannot be evaluated at some point (the
+    /// caller's own evaluation then reports it). Why: the inner fit of a profile of `min` or
+    /// `product` holds one factor, which is the same at each of its iterations; on 100 000
+    /// points of distinct sizes recomputing it was a third of each iteration.
+    pub(super) fn held_row(&self, axis: usize, x: f64) -> Option<Arc<Vec<f64>>> {
+        let key = (axis, x.to_bits());
+        let memo = || self.held.0.lock().unwrap_or_else(|e| e.into_inner());
+        {
+            let mut m = memo();
+            if let Some(at) = m.iter().position(|(k, _)| *k == key) {
+                let kept = m.remove(at);
+                let row = Arc::clone(&kept.1);
+                m.push(kept);
+                return Some(row);
+            }
+        }
+        let mut row = vec![0.0; self.len()];
+        if axis == 0 {
+            self.e_vm_row(x, &mut row);
+        } else {
+            self.e_pm_row(x, &mut row);
+        }
+        if row.iter().any(|v| v.is_nan()) {
+            return None;
+        }
+        let row = Arc::new(row);
+        let mut m = memo();
+        if m.len() == HELD_ROWS {
+            m.remove(0);
+        }
+        m.push((key, Arc::clone(&row)));
+        Some(row)
     }
 
     /// The row kept under `key` (an axis and the bits of its t), made by `make` the first time

@@ -84,18 +84,40 @@ impl Evaluator<'_> {
             None => (&[][..], &mut [][..]),
         };
         // A factor whose parameter is held (a profile's) needs its values, not its slopes: the
-        // same values without the slopes' work.
+        // same values without the slopes' work, and on large data the same at each iteration
+        // of the profile's inner fit (kept by the evaluator, [`Evaluator::held_row`]).
         let slope = [axes.contains(&0), axes.contains(&1)];
+        let held = match (kind, slope) {
+            (ModelKind::Min | ModelKind::Product, [true, false])
+                if super::super::sums::is_large(n) =>
+            {
+                self.held_row(1, p[1]).map(|r| (1, r))
+            }
+            (ModelKind::Min | ModelKind::Product, [false, true])
+                if super::super::sums::is_large(n) =>
+            {
+                self.held_row(0, p[0]).map(|r| (0, r))
+            }
+            _ => None,
+        };
+        let held_rows = |axis: usize, at: std::ops::Range<usize>| match &held {
+            Some((h, row)) if *h == axis => Some(&row[at]),
+            _ => None,
+        };
         let chunk = |start: usize, c0: &mut [f64], c1: &mut [f64], f: &mut [f64]| -> Result<()> {
             let m = c0.len();
             let (mut ev, mut sv) = (vec![1.0; m], vec![0.0; m]);
-            if kind != ModelKind::Pm {
+            if let Some(row) = held_rows(0, start..start + m) {
+                ev.copy_from_slice(row);
+            } else if kind != ModelKind::Pm {
                 self.vm_in_kappa_order(start, eta, &mut ev, slope[0].then_some(&mut sv[..]))?;
             }
             // e_pm and its slope in ln u (times d ln u/d ln sigma_y = -5/2 below) four points
             // at a time: the same doubles as point by point.
             let (mut ep, mut sp) = (vec![1.0; m], vec![0.0; m]);
-            if kind != ModelKind::Vm {
+            if let Some(row) = held_rows(1, start..start + m) {
+                ep.copy_from_slice(row);
+            } else if kind != ModelKind::Vm {
                 for (j, u) in ep.iter_mut().enumerate() {
                     *u = self.u_s25(start + j, s25);
                 }
@@ -171,9 +193,11 @@ mod tests {
     use super::super::super::dataset::{FitData, Observation};
     use super::super::super::lsq::{self, Residuals};
     use super::super::super::objective::Objective;
+    use super::super::HELD_ROWS;
     use super::*;
     use crate::contact::Material;
     use crate::models::viscoelastic::ContactEnd;
+    use std::sync::Arc;
 
     /// Exact against central differences (h = the objective's fd_step), on data off every model
     /// (residuals of both signs), a pair, unequal spheres and a wall, speeds on both sides of
@@ -199,7 +223,10 @@ mod tests {
     /// The residuals and Jacobian of one pass (Levenberg-Marquardt's trial points) are those of
     /// the two separate computations to the last bit, on small data and on data large enough
     /// for the chunked parallel path (20 000 points, every speed distinct), for every separable
-    /// model, both rules and every set of free parameters.
+    /// model, both rules and every set of free parameters. With one parameter held on the
+    /// large data, the pass's residuals come from the evaluator's held row
+    /// ([`Evaluator::held_row`], made by the separate Jacobian just before): to the last bit
+    /// those of the residuals computed afresh.
     #[test]
     fn residuals_with_the_jacobian_are_the_separate_ones_bit_for_bit() {
         let m = Material::preset("nylon").unwrap();
@@ -249,6 +276,39 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A held row is the evaluator's own row of that factor, the same row again when asked
+    /// again, and made afresh once HELD_ROWS others were asked for since.
+    #[test]
+    fn held_rows_are_the_factors_rows_kept_for_the_last_asked() {
+        let m = Material::preset("nylon").unwrap();
+        let obs: Vec<Observation> = (0..300)
+            .map(|i| Observation {
+                d_mm: 6.35 + 0.01 * i as f64,
+                d2_mm: None,
+                v_n_m_s: 0.1 * 1.02f64.powi(i),
+                e: 0.8,
+                e_err: Some(0.01),
+            })
+            .collect();
+        let data = FitData::new(m, obs).unwrap();
+        let ev = Evaluator::new(&data, ContactEnd::Overlap, VmMethod::Master);
+        let (eta, sigma) = (190.0, 4.0e7);
+        let (mut vm, mut pm) = (vec![0.0; 300], vec![0.0; 300]);
+        ev.e_vm_row(eta, &mut vm);
+        ev.e_pm_row(sigma, &mut pm);
+        let a = ev.held_row(0, eta).unwrap();
+        assert_eq!(*a, vm);
+        assert_eq!(*ev.held_row(1, sigma).unwrap(), pm);
+        assert!(Arc::ptr_eq(&a, &ev.held_row(0, eta).unwrap()));
+        for k in 0..HELD_ROWS {
+            ev.held_row(1, sigma * (1.0 + 0.01 * (k + 1) as f64))
+                .unwrap();
+        }
+        let again = ev.held_row(0, eta).unwrap();
+        assert!(!Arc::ptr_eq(&a, &again));
+        assert_eq!(*again, vm);
     }
 
     #[test]
