@@ -231,8 +231,10 @@ fn profile_end(
     // for small data, whose inner fits are cheap and whose profiles' global inner searches
     // (run where the local value is at or above the threshold) cost more when the local values
     // stop that much higher: the 120 shipped points' `--model all` took 1.7% more instructions.
-    let enough = |_: f64| 0.01 * CROSSING_TOL * 2.0 * delta / step;
-    let enough = sums::is_large(obj.n_residuals()).then_some(&enough as &dyn Fn(f64) -> f64);
+    let promise = 0.01 * CROSSING_TOL * 2.0 * delta / step;
+    let enough = |_: f64| promise;
+    let enough = (sums::is_large(obj.n_residuals()) && promise.is_finite())
+        .then_some(&enough as &dyn Fn(f64) -> f64);
     let failed_inner = Cell::new(0u32);
     let warm = RefCell::new(vec![(theta[j], theta.to_vec())]);
     let lower_found = RefCell::new(None::<Vec<f64>>);
