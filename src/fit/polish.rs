@@ -73,9 +73,10 @@ pub fn polish_brent(obj: &Objective, t: f64, lo: f64, hi: f64, at_node: f64) -> 
 /// Line searches from a local minimum along the principal axes of its covariance (the valley
 /// first), each a grid of `VALLEY_POINTS` over +-[`VALLEY_REACH`] standard errors then Brent's
 /// method around the best grid point, followed by Levenberg-Marquardt from the lowest point;
-/// repeated while a round gains more than a hundredth of the search's tolerance. Levenberg-Marquardt can stop on a kink of `min` (its Gauss-Newton
-/// model sees one branch) or in a long flat valley with shallow wiggles; a derivative-free line
-/// search along the valley does not.
+/// repeated while a round gains more than a hundredth of the search's tolerance.
+/// Levenberg-Marquardt can stop on a kink of `min` (its Gauss-Newton model sees one branch) or
+/// in a long flat valley with shallow wiggles; a derivative-free line search along the valley
+/// does not.
 ///
 /// `may_beat(theta)`: false where the global search has proved chi2 no lower than its
 /// tolerance below the best minimum known ([`super::bnb::Bnb::may_hold_below`]); the scan's
