@@ -251,43 +251,30 @@ pub struct Evaluator<'a> {
     kappa_order: Vec<u32>,
     /// kappa per unit eta in that order (read in sequence, not gathered).
     kappa_per_eta_in_order: Vec<f64>,
-    /// The rows of e_vm and e_pm the global searches asked for ([`Evaluator::row`]).
+    /// The rows of e_vm and e_pm the global searches asked for ([`Evaluator::row`]) and the
+    /// last rows of a held factor ([`Evaluator::held_row`]).
     rows: RowMemo,
-    /// The last rows of a held factor ([`Evaluator::held_row`]).
-    held: HeldRows,
 }
 
-/// The last [`HELD_ROWS`] rows of e_vm (axis 0, by the bits of eta) and of e_pm (axis 1, by the
-/// bits of sigma_y) held by a profile's inner fits, most recent last ([`Evaluator::held_row`]).
-/// A clone starts empty.
-#[derive(Default)]
-struct HeldRows(Mutex<Vec<(RowKey, Arc<Vec<f64>>)>>);
-
-/// Rows kept by [`HeldRows`]: the profile ends of `min` and `product` run side by side, two
-/// with each parameter held, so eight rows serve both models' ends at once.
+/// Rows kept by [`RowMemo`]'s `held`: the profile ends of `min` and `product` run side by side,
+/// two with each parameter held, so eight rows serve both models' ends at once.
 pub(super) const HELD_ROWS: usize = 8;
 
-impl Clone for HeldRows {
-    fn clone(&self) -> Self {
-        HeldRows::default()
-    }
-}
-
-impl fmt::Debug for HeldRows {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str("HeldRows")
-    }
-}
-
-/// Rows of e_vm (axis 0) and e_pm (axis 1) over every point, by axis and the bits of the log
-/// of the parameter, and the power law's rows of exp(-a x1) and exp(b x2) (axes 2 and 3, by the
-/// bits of a and b; [`Evaluator::memo_row`]). Kept for the whole fit: on 100 000 distinct points
-/// `fit --model all` peaks at 303 MB against 276 MB when the power law's were not kept. The searches of `vm`, `pm`, `min` and `product` share their grids (the
-/// same search boxes cut at the same dyadic points), so on 100 000 distinct points 60 of 150
-/// e_vm rows and 40 of 120 e_pm rows were computed again by another model of `fit --model all`.
-/// A clone starts empty.
+/// `kept`: rows of e_vm (axis 0) and e_pm (axis 1) over every point, by axis and the bits of
+/// the log of the parameter, and the power law's rows of exp(-a x1) and exp(b x2) (axes 2 and 3,
+/// by the bits of a and b; [`Evaluator::memo_row`]). Kept for the whole fit: on 100 000
+/// distinct points `fit --model all` peaks at 303 MB against 276 MB when the power law's were
+/// not kept. The searches of `vm`, `pm`, `min` and `product` share their grids (the same search
+/// boxes cut at the same dyadic points), so on 100 000 distinct points 60 of 150 e_vm rows and
+/// 40 of 120 e_pm rows were computed again by another model of `fit --model all`.
+/// `held`: the last [`HELD_ROWS`] rows of e_vm (axis 0, by the bits of eta) and of e_pm (axis
+/// 1, by the bits of sigma_y) held by a profile's inner fits, most recent last
+/// ([`Evaluator::held_row`]). A clone starts empty.
 #[derive(Default)]
-struct RowMemo(Mutex<HashMap<RowKey, Arc<Vec<f64>>>>);
+struct RowMemo {
+    kept: Mutex<HashMap<RowKey, Arc<Vec<f64>>>>,
+    held: Mutex<Vec<(RowKey, Arc<Vec<f64>>)>>,
+}
 
 /// (axis, bits of t).
 type RowKey = (usize, u64);
@@ -330,7 +317,6 @@ impl<'a> Evaluator<'a> {
             kappa_order: Vec::new(),
             kappa_per_eta_in_order: Vec::new(),
             rows: RowMemo::default(),
-            held: HeldRows::default(),
         };
         if method == VmMethod::Master {
             let kpe = &ev.kappa_per_eta;
@@ -556,7 +542,7 @@ impl<'a> Evaluator<'a> {
     /// points of distinct sizes recomputing it was a third of each iteration.
     pub(super) fn held_row(&self, axis: usize, x: f64) -> Option<Arc<Vec<f64>>> {
         let key = (axis, x.to_bits());
-        let memo = || self.held.0.lock().unwrap_or_else(|e| e.into_inner());
+        let memo = || self.rows.held.lock().unwrap_or_else(|e| e.into_inner());
         {
             let mut m = memo();
             if let Some(at) = m.iter().position(|(k, _)| *k == key) {
@@ -589,7 +575,7 @@ impl<'a> Evaluator<'a> {
     /// landscape keeps its rows of exp(-a x1) and exp(b x2) under 2 and 3: its searches over
     /// the exponents and every slice of its profiles share the grid's rows).
     pub fn memo_row(&self, key: (usize, u64), make: impl FnOnce() -> Vec<f64>) -> Arc<Vec<f64>> {
-        let memo = || self.rows.0.lock().unwrap_or_else(|e| e.into_inner());
+        let memo = || self.rows.kept.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(row) = memo().get(&key) {
             return Arc::clone(row);
         }

@@ -88,15 +88,12 @@ impl Evaluator<'_> {
         // of the profile's inner fit (kept by the evaluator, [`Evaluator::held_row`]).
         let slope = [axes.contains(&0), axes.contains(&1)];
         let held = match (kind, slope) {
-            (ModelKind::Min | ModelKind::Product, [true, false])
-                if super::super::sums::is_large(n) =>
+            // One axis free: the other (1 where axis 0 is free) is held, at p[h].
+            (ModelKind::Min | ModelKind::Product, [free0, free1])
+                if free0 != free1 && super::super::sums::is_large(n) =>
             {
-                self.held_row(1, p[1]).map(|r| (1, r))
-            }
-            (ModelKind::Min | ModelKind::Product, [false, true])
-                if super::super::sums::is_large(n) =>
-            {
-                self.held_row(0, p[0]).map(|r| (0, r))
+                let h = usize::from(free0);
+                self.held_row(h, p[h]).map(|r| (h, r))
             }
             _ => None,
         };
