@@ -8,6 +8,10 @@ use super::objective::{ERROR_PER_ACCURACY, MASTER_ACCURACY};
 use crate::contact::{Contact, Material, Pair, Sphere};
 use crate::error::{Error, Result};
 
+/// A hash map keyed by numbers' bits, with a fast fixed-seed hash (std's SipHash guards against
+/// chosen keys, which a data file cannot exploit here; it cost more than the merge itself).
+type BitsMap<K, V> = std::collections::HashMap<K, V, foldhash::fast::FixedState>;
+
 /// One measured collision.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Observation {
@@ -160,8 +164,7 @@ impl FitData {
         // bits are equal values): a search through the groups so far made 100 000 rows of
         // distinct sizes take seconds.
         let mut groups: Vec<Group> = Vec::new();
-        let mut index: std::collections::HashMap<(u64, Option<u64>), usize> =
-            std::collections::HashMap::new();
+        let mut index: BitsMap<(u64, Option<u64>), usize> = BitsMap::default();
         for (i, o) in self.obs.iter().enumerate() {
             let key = (o.d_mm.to_bits(), o.d2_mm.map(f64::to_bits));
             match index.get(&key) {
@@ -249,8 +252,8 @@ impl FitData {
             )
         };
         // Sized for every row at once: growing by rehashing cost more than the merge itself.
-        let mut index: std::collections::HashMap<_, usize> =
-            std::collections::HashMap::with_capacity(self.obs.len());
+        let mut index: BitsMap<_, usize> =
+            BitsMap::with_capacity_and_hasher(self.obs.len(), Default::default());
         let mut point_of_row = Vec::with_capacity(self.obs.len());
         let mut first_row = Vec::new();
         for (i, o) in self.obs.iter().enumerate() {
