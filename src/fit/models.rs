@@ -320,15 +320,25 @@ impl<'a> Evaluator<'a> {
         };
         if method == VmMethod::Master {
             let kpe = &ev.kappa_per_eta;
-            ev.kappa_order = Vec::with_capacity(kpe.len());
-            for block in kpe.chunks(sums::CHUNK) {
-                let at = ev.kappa_order.len();
-                ev.kappa_order.extend(0..block.len() as u32);
-                ev.kappa_order[at..].sort_unstable_by(|&x, &y| {
+            ev.kappa_order = (0..kpe.len()).map(|i| (i % sums::CHUNK) as u32).collect();
+            let sort = |(order, block): (&mut [u32], &[f64])| {
+                order.sort_unstable_by(|&x, &y| {
                     block[x as usize]
                         .total_cmp(&block[y as usize])
                         .then(x.cmp(&y))
-                });
+                })
+            };
+            // The chunks are independent: large data sort them side by side (a serial part of
+            // the fit's start, before any model runs).
+            if sums::is_large(kpe.len()) {
+                use rayon::prelude::*;
+                (ev.kappa_order.par_chunks_mut(sums::CHUNK))
+                    .zip(kpe.par_chunks(sums::CHUNK))
+                    .for_each(sort);
+            } else {
+                (ev.kappa_order.chunks_mut(sums::CHUNK))
+                    .zip(kpe.chunks(sums::CHUNK))
+                    .for_each(sort);
             }
             ev.kappa_per_eta_in_order = (ev.kappa_order.iter().enumerate())
                 .map(|(i, &j)| kpe[i / sums::CHUNK * sums::CHUNK + j as usize])
