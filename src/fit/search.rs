@@ -50,7 +50,7 @@
 //! switched off ([`super::FitOptions::scan`]).
 
 use super::FitOptions;
-use super::bnb::{Bnb, Candidate, CellBox, Landscape, Limits, starting_rows};
+use super::bnb::{Bnb, Candidate, CellBox, KnownNodes, Landscape, Limits, starting_rows};
 use super::kinks::{KinkStart, axis_stderr, kink_starts, polish_profiles};
 use super::landscape::{PowerLaw, Separable};
 use super::models::{Evaluator, ModelKind};
@@ -100,6 +100,8 @@ pub struct SearchOutcome {
 pub struct Region {
     pub cells: Vec<CellBox>,
     pub resolution: [f64; 2],
+    /// The chi2 the search computed at the cells' corners (for a search on the same landscape).
+    pub nodes: KnownNodes,
 }
 
 /// The tolerance tau for a best value U of the points' chi2 (the rows' chi2 sets the relative
@@ -641,9 +643,13 @@ fn run<L: Landscape>(
         .into_iter()
         .map(|(r, t, v)| (to_theta(&bnb.land, r, t), v))
         .collect();
-    let region = keeps_region.then(|| Region {
-        cells: bnb.cells_below(threshold),
-        resolution: fine_width.unwrap_or([0.0, 0.0]),
+    let region = keeps_region.then(|| {
+        let cells = bnb.cells_below(threshold);
+        Region {
+            nodes: bnb.known_nodes(&cells),
+            cells,
+            resolution: fine_width.unwrap_or([0.0, 0.0]),
+        }
     });
     Ok(SearchOutcome {
         global: GlobalSearch {

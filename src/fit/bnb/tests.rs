@@ -10,6 +10,8 @@ struct TwoWells {
     y: Vec<f64>,
     /// Loosen the bound by the cell's widths (still valid, but it needs splitting).
     loose: bool,
+    /// Nodes evaluated so far.
+    evaluated: std::cell::Cell<usize>,
 }
 fn g(x: f64) -> f64 {
     ((x + 1.0).powi(2) + 0.5).min((x - 2.0).powi(2))
@@ -29,6 +31,7 @@ impl TwoWells {
             x: vec![],
             y: vec![],
             loose,
+            evaluated: Default::default(),
         }
     }
 }
@@ -49,6 +52,7 @@ impl Landscape for TwoWells {
         Ok(())
     }
     fn node(&self, r: [usize; 2]) -> f64 {
+        self.evaluated.set(self.evaluated.get() + 1);
         g(self.x[r[0]]) + (self.y[r[1]] - 0.3).powi(2)
     }
     fn bound(&self, lo: [usize; 2], hi: [usize; 2], _target: f64) -> Bound {
@@ -461,4 +465,69 @@ fn a_search_restricted_to_a_half_plane_ignores_what_lies_beyond() {
     for c in b.candidates(0.02) {
         assert!(c.t[0] <= 1.9, "{c:?}");
     }
+}
+
+/// [`Bnb::set_known_nodes`]: a search beyond a cut started on another search's cells, given
+/// that search's nodes at their corners ([`Bnb::known_nodes`]), is the same search (the same
+/// rows in the same order, best node, certificate, cells and candidates) without evaluating
+/// those nodes again; and a known value is what the search takes (a deliberately wrong one
+/// shows through), so it is not computed anyway.
+#[test]
+fn known_nodes_spare_their_evaluation_and_change_nothing_else() {
+    let tau = |_: f64| 1e-3;
+    let mut first = sparse_two_wells(true);
+    first.start_on(&grid_cells(0..10), f64::INFINITY);
+    first.refine(f64::INFINITY, &tau, &|u| u);
+    let region = first.cells_below(0.6);
+    let known = first.known_nodes(&region);
+    assert!(!known.0.is_empty());
+    let cut = Cut {
+        axis: 0,
+        at: 1.9,
+        dir: -1.0,
+        width: 0.01,
+    };
+    let search = |known: Option<KnownNodes>| {
+        let mut b = sparse_two_wells(true);
+        b.set_cut(cut);
+        if let Some(k) = known {
+            b.set_known_nodes(k);
+        }
+        let cells: Vec<([u64; 2], [u64; 2])> = (region.iter())
+            .filter(|c| b.reaches_cut(c))
+            .map(|c| (c.p0, c.p1))
+            .collect();
+        assert!(!cells.is_empty());
+        b.start_on(&cells, 0.6 - 1e-3);
+        b.refine(0.6, &tau, &|u| u);
+        b
+    };
+    let (mut plain, mut seeded) = (search(None), search(Some(known.clone())));
+    assert_eq!(plain.land.x, seeded.land.x);
+    assert_eq!(plain.land.y, seeded.land.y);
+    assert_eq!(plain.best_node(), seeded.best_node());
+    assert_eq!(plain.certificate(0.6), seeded.certificate(0.6));
+    assert_eq!(plain.cells, seeded.cells);
+    assert_eq!(plain.cells_below(0.6), seeded.cells_below(0.6));
+    let (a, b) = (plain.land.evaluated.get(), seeded.land.evaluated.get());
+    assert!(
+        b < a,
+        "{b} nodes evaluated with the known ones, {a} without"
+    );
+    assert_eq!(plain.candidates(0.6), seeded.candidates(0.6));
+    // The best node of the search (before its candidates, which evaluate nodes of their
+    // own), given a known value far below: taken as it is.
+    let b = search(Some(known.clone()));
+    let (_, t, _) = b.best_node().unwrap();
+    let p = [0, 1].map(|k| {
+        let a = &b.axes[k];
+        *a.row_of
+            .iter()
+            .find(|(_, r)| a.t[**r] == t[k])
+            .map(|(p, _)| p)
+            .unwrap()
+    });
+    let mut wrong = known;
+    wrong.0.insert(p, -7.0);
+    assert_eq!(search(Some(wrong)).best_node().map(|b| b.2), Some(-7.0));
 }
