@@ -185,12 +185,13 @@ type Point = (f64, Vec<f64>, f64, bool);
 /// the brackets shrink). A local value below the threshold shows the profile below it (the
 /// profile is at most that), so the bracket's inner end needs no check, and nothing between
 /// is claimed. Where the inner search puts the outer end below the threshold after all, the
-/// crossing is searched again outwards from there, the warm starts beginning at the point it
-/// found (a part of the region the local minimisation missed; from the points before, in the
-/// valley the local minimisation followed, they led back into it), LAZY_ROUNDS times, then
-/// with the inner search at every point at or above the threshold. Why: running it at every
-/// such point, as before, cost two to five inner searches per end where one decides (the power
-/// law's 100 000 distinct points: four fifths of its profiles' time).
+/// crossing is searched again outwards from there, its first step from the parabola through
+/// the end's starting point and the point found ([`restart_step`]), the warm starts beginning
+/// at the point it found (a part of the region the local minimisation missed; from the points
+/// before, in the valley the local minimisation followed, they led back into it), LAZY_ROUNDS
+/// times, then with the inner search at every point at or above the threshold. Why: running it
+/// at every such point, as before, cost two to five inner searches per end where one decides
+/// (the power law's 100 000 distinct points: four fifths of its profiles' time).
 fn profile_end(
     obj: &impl Residuals,
     from: (&[f64], f64),
