@@ -16,7 +16,8 @@
 //! bound is below the threshold (every other point of the box is shown above it), restricted to
 //! the half-plane theta_j >= end + margin (or <= end - margin): cells wholly inside are dropped,
 //! a cell across it is split on that axis down to the margin or the search's resolution, and
-//! there bounded over its part beyond alone (from a row at the edge), nodes inside do not count.
+//! then bounded over its part beyond alone (from a row at the edge) before any split on the
+//! other axis (whose halves would stay across it), nodes inside do not count.
 //! For the power law's A, which the landscape profiles out rather than tabulates, the half-plane
 //! is A's range itself: the landscape's bounds and nodes minimise over that range. A cell whose
 //! bound reaches the threshold less tau holds no such point; a node below the threshold is one;

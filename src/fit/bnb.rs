@@ -626,7 +626,9 @@ impl<L: Landscape> Bnb<L> {
 
     /// Restricts the search to the half-plane `cut` (see [`Cut`]): cells wholly outside it are
     /// dropped, nodes outside it are not the best node, and a cell across its `at` is split on
-    /// its axis down to its width. Before the starting cells ([`Bnb::start_on`]).
+    /// its axis down to its width, then bounded over its part in the half-plane
+    /// ([`Bnb::clipped`]) before any split on the other axis. Before the starting cells
+    /// ([`Bnb::start_on`]).
     pub fn set_cut(&mut self, cut: Cut) {
         self.cut = Some(cut);
     }
@@ -699,6 +701,18 @@ impl<L: Landscape> Bnb<L> {
                     .push((cell, "the search budget ran out".to_string()));
                 continue;
             }
+            // A cell across the cut no wider there than the cut's width is bounded over its part
+            // beyond the cut first, as at the resolution: split on the other axis, its halves
+            // stay across the cut, holding points inside the interval below the target that no
+            // bound over them whole can clear (`product`'s upper end of eta on 100 000 points of
+            // distinct sizes: sigma_y halved down to its resolution, 146 cells, now 43).
+            if self.cut.is_some()
+                && !self.straddles_cut(&cell)
+                && let Some(c) = self.clipped(&cell, u - tau)
+            {
+                self.done.push(c);
+                continue;
+            }
             let children = match self.split(&cell) {
                 Split::Cells(c) => c,
                 Split::Fine => {
@@ -765,11 +779,12 @@ impl<L: Landscape> Bnb<L> {
             .is_none_or(|k| k.reaches(c.t0[k.axis], c.t1[k.axis]))
     }
 
-    /// A cell at the resolution across the cut's `at`, bounded over its part in the half-plane
-    /// alone (between a row at `at` and its far edge): the cell with that bound where it
-    /// reaches `target` (it holds no searched point below it), else None. A cell across the cut
-    /// holds points outside it, inside an interval, whose chi2 is below the target: bounded
-    /// whole it could only be left to a polish.
+    /// A cell across the cut's `at` (no wider there than the cut's width, or at the
+    /// resolution), bounded over its part in the half-plane alone (between a row at `at` and
+    /// its far edge): the cell with that bound where it reaches `target` (it holds no searched
+    /// point below it), else None. A cell across the cut holds points outside it, inside an
+    /// interval, whose chi2 is below the target: bounded whole it could only be left to a
+    /// polish.
     fn clipped(&mut self, c: &Cell, target: f64) -> Option<Cell> {
         let k = self.cut?;
         let a = &self.axes[k.axis];

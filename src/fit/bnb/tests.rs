@@ -531,3 +531,37 @@ fn known_nodes_spare_their_evaluation_and_change_nothing_else() {
     wrong.0.insert(p, -7.0);
     assert_eq!(search(Some(wrong)).best_node().map(|b| b.2), Some(-7.0));
 }
+
+/// A cell across the cut no wider there than the cut's width is bounded over its part beyond
+/// the cut before any split: with the resolution on x (0.3) above the width of the starting cell
+/// [1.75, 2] across x = 1.9, that cell is cleared whole, not halved on y down to y's
+/// resolution (0.01), where each half, still across the cut and holding g(2) = 0 below the
+/// target, would only have been cleared at the end by the same bound over its part beyond.
+#[test]
+fn a_narrow_cell_across_the_cut_is_bounded_over_its_part_beyond_before_any_split() {
+    let tau = |_: f64| 1e-4;
+    let mut b = sparse_two_wells(false);
+    b.set_cut(Cut {
+        axis: 0,
+        at: 1.9,
+        dir: -1.0,
+        width: 0.3,
+    });
+    b.set_resolution([0.3, 0.01]);
+    b.start_on(&grid_cells(0..10), 0.005 - 1e-4);
+    b.refine(0.005, &tau, &|u| u);
+    let c = b.certificate(0.005);
+    assert!(
+        c.lowest >= 0.005 - 1e-4 && c.reasons.is_empty() && c.fine_cells == 0,
+        "{c:?}"
+    );
+    let across: Vec<CellBox> = b
+        .cells_below(f64::INFINITY)
+        .into_iter()
+        .filter(|c| c.t0[0] < 1.9 && 1.9 < c.t1[0])
+        .collect();
+    assert!(!across.is_empty());
+    for c in across {
+        assert!(c.t1[1] - c.t0[1] >= 0.5 - 1e-12, "{c:?}");
+    }
+}
