@@ -395,6 +395,24 @@ fn cells_around_a_polished_point_are_left_at_the_resolution() {
     }
 }
 
+/// The search of TwoWells (exact bounds) restricted to `cut` at `resolution`, against the
+/// target 0.005 (tau 1e-4), checked clear: no point of the half-plane below the target less tau,
+/// nothing left to a polish.
+fn cleared_beyond(cut: Cut, resolution: [f64; 2]) -> Bnb<TwoWells> {
+    let tau = |_: f64| 1e-4;
+    let mut b = sparse_two_wells(false);
+    b.set_cut(cut);
+    b.set_resolution(resolution);
+    b.start_on(&grid_cells(0..10), 0.005 - 1e-4);
+    b.refine(0.005, &tau, &|u| u);
+    let c = b.certificate(0.005);
+    assert!(
+        c.lowest >= 0.005 - 1e-4 && c.reasons.is_empty() && c.fine_cells == 0,
+        "{c:?}"
+    );
+    b
+}
+
 /// [`Bnb::set_cut`]: restricted to x <= 1.9, the search sees the minimum of that half-plane
 /// (g(1.9) = 0.01 on its edge), not the box's (0 at x = 2, beyond it). Against a target of
 /// 0.005 no point of the half-plane is lower: certified to tau although the cells across
@@ -433,16 +451,7 @@ fn a_search_restricted_to_a_half_plane_ignores_what_lies_beyond() {
     // With a resolution of 0.3 the cell across x = 1.9 stops at [1.75, 2] on x: bounded whole
     // it holds x = 2 (0), and over its part x <= 1.9 alone (a row at 1.9) it clears the
     // target: nothing is left to a polish.
-    let mut b = sparse_two_wells(false);
-    b.set_cut(Cut { width: 0.3, ..cut });
-    b.set_resolution([0.3, 0.3]);
-    b.start_on(&grid_cells(0..10), 0.005 - 1e-4);
-    b.refine(0.005, &tau, &|u| u);
-    let c = b.certificate(0.005);
-    assert!(
-        c.lowest >= 0.005 - 1e-4 && c.reasons.is_empty() && c.fine_cells == 0,
-        "{c:?}"
-    );
+    let b = cleared_beyond(Cut { width: 0.3, ..cut }, [0.3, 0.3]);
     assert!(b.land.x.contains(&1.9), "{:?}", b.land.x);
     assert!(
         b.cells_below(f64::INFINITY)
@@ -539,22 +548,13 @@ fn known_nodes_spare_their_evaluation_and_change_nothing_else() {
 /// target, would only have been cleared at the end by the same bound over its part beyond.
 #[test]
 fn a_narrow_cell_across_the_cut_is_bounded_over_its_part_beyond_before_any_split() {
-    let tau = |_: f64| 1e-4;
-    let mut b = sparse_two_wells(false);
-    b.set_cut(Cut {
+    let cut = Cut {
         axis: 0,
         at: 1.9,
         dir: -1.0,
         width: 0.3,
-    });
-    b.set_resolution([0.3, 0.01]);
-    b.start_on(&grid_cells(0..10), 0.005 - 1e-4);
-    b.refine(0.005, &tau, &|u| u);
-    let c = b.certificate(0.005);
-    assert!(
-        c.lowest >= 0.005 - 1e-4 && c.reasons.is_empty() && c.fine_cells == 0,
-        "{c:?}"
-    );
+    };
+    let b = cleared_beyond(cut, [0.3, 0.01]);
     let across: Vec<CellBox> = b
         .cells_below(f64::INFINITY)
         .into_iter()
