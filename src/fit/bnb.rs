@@ -627,7 +627,7 @@ impl<L: Landscape> Bnb<L> {
     /// Restricts the search to the half-plane `cut` (see [`Cut`]): cells wholly outside it are
     /// dropped, nodes outside it are not the best node, and a cell across its `at` is split on
     /// its axis down to its width, then bounded over its part in the half-plane
-    /// ([`Bnb::clipped`]) before any split on the other axis. Before the starting cells
+    /// (`Bnb::clipped`) before any split on the other axis. Before the starting cells
     /// ([`Bnb::start_on`]).
     pub fn set_cut(&mut self, cut: Cut) {
         self.cut = Some(cut);
