@@ -715,11 +715,10 @@ impl<L: Landscape> Bnb<L> {
             }
             let children = match self.split(&cell) {
                 Split::Cells(c) => c,
+                // A cell across the cut never comes here wider than the cut's width (it is
+                // split on the cut's axis), so its part beyond was bounded above already.
                 Split::Fine => {
-                    match self.clipped(&cell, u - tau) {
-                        Some(c) => self.done.push(c),
-                        None => self.fine.push(cell),
-                    }
+                    self.fine.push(cell);
                     continue;
                 }
                 Split::Finest => {
@@ -779,8 +778,8 @@ impl<L: Landscape> Bnb<L> {
             .is_none_or(|k| k.reaches(c.t0[k.axis], c.t1[k.axis]))
     }
 
-    /// A cell across the cut's `at` (no wider there than the cut's width, or at the
-    /// resolution), bounded over its part in the half-plane alone (between a row at `at` and
+    /// A cell across the cut's `at` (no wider there than the cut's width, which is at least
+    /// the resolution), bounded over its part in the half-plane alone (between a row at `at` and
     /// its far edge): the cell with that bound where it reaches `target` (it holds no searched
     /// point below it), else None. A cell across the cut holds points outside it, inside an
     /// interval, whose chi2 is below the target: bounded whole it could only be left to a

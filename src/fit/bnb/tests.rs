@@ -526,16 +526,7 @@ fn known_nodes_spare_their_evaluation_and_change_nothing_else() {
     assert_eq!(plain.candidates(0.6), seeded.candidates(0.6));
     // The best node of the search (before its candidates, which evaluate nodes of their
     // own), given a known value far below: taken as it is.
-    let b = search(Some(known.clone()));
-    let (_, t, _) = b.best_node().unwrap();
-    let p = [0, 1].map(|k| {
-        let a = &b.axes[k];
-        *a.row_of
-            .iter()
-            .find(|(_, r)| a.t[**r] == t[k])
-            .map(|(p, _)| p)
-            .unwrap()
-    });
+    let (p, _) = search(Some(known.clone())).best.unwrap();
     let mut wrong = known;
     wrong.0.insert(p, -7.0);
     assert_eq!(search(Some(wrong)).best_node().map(|b| b.2), Some(-7.0));
