@@ -778,8 +778,8 @@ impl<L: Landscape> Bnb<L> {
             .is_none_or(|k| k.reaches(c.t0[k.axis], c.t1[k.axis]))
     }
 
-    /// A cell across the cut's `at` (no wider there than the cut's width, which is at least
-    /// the resolution), bounded over its part in the half-plane alone (between a row at `at` and
+    /// A cell across the cut's `at` (no wider there than the cut's width), bounded over its
+    /// part in the half-plane alone (between a row at `at` and
     /// its far edge): the cell with that bound where it reaches `target` (it holds no searched
     /// point below it), else None. A cell across the cut holds points outside it, inside an
     /// interval, whose chi2 is below the target: bounded whole it could only be left to a
