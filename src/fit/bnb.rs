@@ -779,11 +779,10 @@ impl<L: Landscape> Bnb<L> {
     }
 
     /// A cell across the cut's `at` (no wider there than the cut's width), bounded over its
-    /// part in the half-plane alone (between a row at `at` and
-    /// its far edge): the cell with that bound where it reaches `target` (it holds no searched
-    /// point below it), else None. A cell across the cut holds points outside it, inside an
-    /// interval, whose chi2 is below the target: bounded whole it could only be left to a
-    /// polish.
+    /// part in the half-plane alone (between a row at `at` and its far edge): the cell with
+    /// that bound where it reaches `target` (it holds no searched point below it), else None.
+    /// A cell across the cut holds points outside it, inside an interval, whose chi2 is below
+    /// the target: bounded whole it could only be left to a polish.
     fn clipped(&mut self, c: &Cell, target: f64) -> Option<Cell> {
         let k = self.cut?;
         let a = &self.axes[k.axis];
