@@ -555,3 +555,85 @@ fn many_sizes_are_counted_not_listed() {
     assert!(res.contains("20 geometries") && !res.contains("5 mm on 6 mm"));
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The figures draw a marker once per pixel position it lands on (the same picture), and a
+/// group whose markers land on more than 5000 positions as a density, saying so
+/// (src/plot/fit/points.rs): the shipped data repeated 50 times draw the markers of the shipped
+/// data, no more; 6000 rows of distinct sizes and speeds draw squares, no data markers.
+#[test]
+fn figures_draw_a_marker_once_per_pixel_and_many_as_a_density() {
+    let dir = scratch("markers");
+    let shipped =
+        std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("data/fig7_nylon.csv"))
+            .unwrap();
+    let mut lines = shipped.lines().filter(|l| !l.starts_with('#'));
+    let header = lines.next().unwrap();
+    let rows: Vec<&str> = lines.filter(|l| !l.trim().is_empty()).collect();
+    let mut repeated = format!("{header}\n");
+    for _ in 0..50 {
+        for r in &rows {
+            repeated += r;
+            repeated.push('\n');
+        }
+    }
+    let count = |svg: &str| {
+        ["<circle", "<polygon", "<rect", "<line", "<polyline"].map(|t| svg.matches(t).count())
+    };
+    let mut seen = Vec::new();
+    for (name, text) in [("once.csv", shipped.as_str()), ("x50.csv", &repeated)] {
+        let data = write(&dir, name, text);
+        let out = dir.join(name.replace(".csv", ""));
+        let r = run(&[
+            "fit",
+            &data,
+            "--material",
+            "nylon",
+            "--model",
+            "vm",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(r.ok, "{}", r.stderr);
+        let fig = std::fs::read_to_string(out.join("fig7.svg")).unwrap();
+        let res = std::fs::read_to_string(out.join("residuals.svg")).unwrap();
+        assert!(!fig.contains("density") && !res.contains("density"));
+        seen.push((count(&fig), count(&res)));
+    }
+    assert_eq!(
+        seen[0], seen[1],
+        "elements of the shipped data's figures, once and x50"
+    );
+
+    let mut csv = String::from("d_mm,d2_mm,v_n_m_s,e,e_err\n");
+    for k in 0..6000 {
+        let v = 0.5 * 80f64.powf(k as f64 / 5999.0);
+        let e = 0.95 - 0.04 * v.ln() + 0.03 * ((k * 7919 % 1000) as f64 / 1000.0 - 0.5);
+        csv += &format!("{},{},{v},{e},0.02\n", 5.0 + 1e-4 * k as f64, 6.0);
+    }
+    let data = write(&dir, "spread.csv", &csv);
+    let out = dir.join("spread");
+    let r = run(&[
+        "fit",
+        &data,
+        "--material",
+        "nylon",
+        "--model",
+        "vm",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let fig = std::fs::read_to_string(out.join("fig7.svg")).unwrap();
+    assert!(
+        fig.contains("data as density: 4 px squares shaded by log count (1 to ")
+            && fig.contains("error bars left out"),
+        "no density note in fig7.svg"
+    );
+    // The legend's one marker; the data are squares.
+    assert_eq!(fig.matches("<circle").count(), 1);
+    assert!(fig.matches("<rect").count() > 1000);
+    let res = std::fs::read_to_string(out.join("residuals.svg")).unwrap();
+    assert!(res.contains("where over 5000 positions: 4 px squares shaded by log count"));
+    assert_eq!(res.matches("<circle").count(), 1);
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -253,6 +253,27 @@ fn hundred_thousand_rows_fit() {
             distinct.clone(),
         ));
     }
+    // With the figures: 100 000 markers had made 45 MB of SVG each and a second or more of CPU
+    // (the figures now draw a marker once per pixel, or a density: src/plot/fit/points.rs).
+    for (label, bytes) in [("", fig7_rows(100_000, None)), (" distinct", distinct)] {
+        let args = [
+            "fit",
+            "data.csv",
+            "--material",
+            "nylon",
+            "--model",
+            "vm",
+            "--out",
+            "{dir}/out",
+        ];
+        cases.push(file_case(
+            &format!("fit --model vm --out, 100 000{label} rows"),
+            &args,
+            "data.csv",
+            bytes,
+            true,
+        ));
+    }
     assert_clean(&run_all("bigfit", &cases));
 }
 

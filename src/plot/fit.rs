@@ -2,6 +2,7 @@
 //! `residuals.svg` (normalised residuals of every fitted model).
 
 mod fig7;
+mod points;
 mod residuals;
 
 pub use fig7::fig7_svg;
@@ -93,6 +94,10 @@ enum Sample {
     Line(RGBColor, u32),
     Dashed(RGBColor, u32),
     Marker(usize, RGBColor),
+    /// A filled square: data drawn as a density.
+    Block(RGBColor),
+    /// No sample: the text alone.
+    Text,
 }
 
 /// Draws legend entries on `area` (pixel coordinates): column `c` starts at `x0[c]`; entries
@@ -142,6 +147,14 @@ fn draw_legend(
                 }
                 .map_err(svg_err)?;
             }
+            Sample::Block(c) => {
+                area.draw(&Rectangle::new(
+                    [(x + 9, y - 6), (x + 21, y + 6)],
+                    c.filled(),
+                ))
+                .map_err(svg_err)?;
+            }
+            Sample::Text => {}
         }
         area.draw(&Text::new(
             text.clone(),

@@ -1,5 +1,6 @@
 //! `fig7.svg`: the paper's Fig. 7 with the fitted models.
 
+use super::points::{MAX_MARKERS, density_note, draw_density, draw_error_bars, one_per_pixel};
 use super::{
     Sample, colour, describe, draw_legend, draw_markers, drawn_groups, log_points, log_ticks,
     short_value, svg_err,
@@ -10,6 +11,8 @@ use crate::fit::models::{ModelKind, predict_e};
 use crate::fit::result::FitResult;
 use crate::models::viscoelastic::{ContactEnd, VmMethod};
 use crate::plot::{PlotError, PlotFailure, log_axis};
+use plotters::coord::Shift;
+use plotters::coord::combinators::{LogCoord, WithKeyPoints};
 use plotters::prelude::*;
 
 /// The model's e along `vs` for a group's pair, dropping points the axes cannot show.
@@ -129,7 +132,28 @@ fn draw_fig7(
             ),
         ));
     }
-    let legend_rows = legend.len().max(data_key.len()) as u32;
+    // Each group's points, and whether they are drawn as a density (points.rs): the chart's
+    // pixels do not depend on the legend's height below it, so a scratch chart tells.
+    let pts: Vec<Vec<(f64, f64)>> = groups
+        .iter()
+        .map(|g| {
+            g.indices
+                .iter()
+                .map(|&i| (data.obs[i].v_n_m_s, data.obs[i].e))
+                .filter(|p| p.1 > 0.0)
+                .collect()
+        })
+        .collect();
+    let dense: Vec<bool> = {
+        let mut scratch = String::new();
+        let area = SVGBackend::with_string(&mut scratch, (980, 640)).into_drawing_area();
+        let chart = chart_on(&area, title, x_range, y_range)?;
+        pts.iter()
+            .map(|p| one_per_pixel(&chart, p).len() > MAX_MARKERS)
+            .collect()
+    };
+    let notes = dense.iter().filter(|&&d| d).count();
+    let legend_rows = (legend.len() + notes).max(data_key.len()) as u32;
     let legend_h = 24 + legend_rows * 26;
     let height = 640 + legend_h;
 
@@ -138,31 +162,7 @@ fn draw_fig7(
         let root = SVGBackend::with_string(&mut buf, (980, height)).into_drawing_area();
         root.fill(&WHITE).map_err(svg_err)?;
         let (top, bottom) = root.split_vertically(640);
-        let mut chart = ChartBuilder::on(&top)
-            .caption(title, ("sans-serif", 22))
-            .margin(14)
-            .x_label_area_size(58)
-            .y_label_area_size(78)
-            .build_cartesian_2d(
-                (x_range.0..x_range.1)
-                    .log_scale()
-                    .with_key_points(log_ticks(x_range.0, x_range.1)),
-                (y_range.0..y_range.1)
-                    .log_scale()
-                    .with_key_points(log_ticks(y_range.0, y_range.1)),
-            )
-            .map_err(svg_err)?;
-        chart
-            .configure_mesh()
-            .x_desc("normal impact speed v_n (m/s)")
-            .y_desc("coefficient of restitution e")
-            .axis_desc_style(("sans-serif", 20))
-            .label_style(("sans-serif", 16))
-            .x_label_formatter(&|v| short_value(*v))
-            .y_label_formatter(&|e| short_value(*e))
-            .bold_line_style(RGBColor(225, 225, 225))
-            .draw()
-            .map_err(svg_err)?;
+        let mut chart = chart_on(&top, title, x_range, y_range)?;
 
         // Model curves first, so the data stay on top.
         if let Some(f) = find(ModelKind::Vm).filter(|_| !merged) {
@@ -195,30 +195,64 @@ fn draw_fig7(
                     .map_err(svg_err)?;
             }
         }
-        // Data with error bars.
+        // Data with error bars, or as a density (points.rs).
         for (gi, g) in groups.iter().enumerate() {
             let c = colour(gi);
-            chart
-                .draw_series(g.indices.iter().filter_map(|&i| {
-                    let o = data.obs[i];
-                    let s = o.e_err?;
-                    let lo = (o.e - s).max(y_range.0);
-                    let hi = (o.e + s).min(y_range.1);
-                    (o.e > 0.0).then(|| {
-                        ErrorBar::new_vertical(o.v_n_m_s, lo, o.e, hi, c.stroke_width(1), 6)
-                    })
-                }))
-                .map_err(svg_err)?;
-            let pts: Vec<(f64, f64)> = g
-                .indices
-                .iter()
-                .map(|&i| (data.obs[i].v_n_m_s, data.obs[i].e))
-                .filter(|p| p.1 > 0.0)
-                .collect();
-            draw_markers(&mut chart, &pts, gi, 4, c)?;
+            if dense[gi] {
+                let most = draw_density(&mut chart, &pts[gi], c)?;
+                legend.push((Sample::Block(c), density_note(most)));
+                continue;
+            }
+            let bars = g.indices.iter().filter_map(|&i| {
+                let o = data.obs[i];
+                let s = o.e_err?;
+                let lo = (o.e - s).max(y_range.0);
+                let hi = (o.e + s).min(y_range.1);
+                (o.e > 0.0).then_some((o.v_n_m_s, lo, o.e, hi))
+            });
+            draw_error_bars(&mut chart, bars, c.stroke_width(1), 6)?;
+            let shown = one_per_pixel(&chart, &pts[gi]);
+            draw_markers(&mut chart, &shown, gi, 4, c)?;
         }
         draw_legend(&bottom, &[(40, data_key), (260, legend)], 16)?;
         root.present().map_err(svg_err)?;
     }
     Ok(buf)
+}
+
+type LogAxis = WithKeyPoints<LogCoord<f64>>;
+
+/// The figure's chart on `area` (its upper 640 pixels), axes and grid drawn.
+fn chart_on<'a, 'b>(
+    area: &'a DrawingArea<SVGBackend<'b>, Shift>,
+    title: &str,
+    x_range: (f64, f64),
+    y_range: (f64, f64),
+) -> Result<ChartContext<'a, SVGBackend<'b>, Cartesian2d<LogAxis, LogAxis>>, PlotFailure> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 22))
+        .margin(14)
+        .x_label_area_size(58)
+        .y_label_area_size(78)
+        .build_cartesian_2d(
+            (x_range.0..x_range.1)
+                .log_scale()
+                .with_key_points(log_ticks(x_range.0, x_range.1)),
+            (y_range.0..y_range.1)
+                .log_scale()
+                .with_key_points(log_ticks(y_range.0, y_range.1)),
+        )
+        .map_err(svg_err)?;
+    chart
+        .configure_mesh()
+        .x_desc("normal impact speed v_n (m/s)")
+        .y_desc("coefficient of restitution e")
+        .axis_desc_style(("sans-serif", 20))
+        .label_style(("sans-serif", 16))
+        .x_label_formatter(&|v| short_value(*v))
+        .y_label_formatter(&|e| short_value(*e))
+        .bold_line_style(RGBColor(225, 225, 225))
+        .draw()
+        .map_err(svg_err)?;
+    Ok(chart)
 }

@@ -1,5 +1,6 @@
 //! `residuals.svg`: the normalised residuals of every fitted model.
 
+use super::points::{BLOCK_PX, MAX_MARKERS, draw_density, one_per_pixel};
 use super::{
     Sample, colour, describe, draw_legend, draw_markers, drawn_groups, log_ticks, short_value,
     svg_err,
@@ -28,30 +29,27 @@ fn draw_residuals(data: &FitData, set: &FitSet, title: &str) -> Result<String, P
         PlotFailure::NothingToDraw("no speed that is a finite positive number".into())
     })?;
     let panel_h = 190u32;
+    // The key: KEY_COLUMNS groups to a row, and a row for the density's note where a group has
+    // enough points to need one (left empty where no panel drew one).
+    const KEY_COLUMNS: usize = 4;
+    const KEY_ROW: u32 = 25;
+    let note_row = drawn.iter().any(|(g, _)| g.indices.len() > MAX_MARKERS);
+    let key_rows = drawn.len().div_ceil(KEY_COLUMNS) as u32 + note_row as u32;
+    let key_h = 34 + KEY_ROW * key_rows.saturating_sub(1);
     let mut buf = String::new();
     {
-        let root =
-            SVGBackend::with_string(&mut buf, (960, 100 + panel_h * n as u32)).into_drawing_area();
+        let root = SVGBackend::with_string(&mut buf, (960, 66 + key_h + panel_h * n as u32))
+            .into_drawing_area();
         root.fill(&WHITE).map_err(svg_err)?;
         let root = root.titled(title, ("sans-serif", 22)).map_err(svg_err)?;
-        let (key, body) = root.split_vertically(34);
-        let columns: Vec<(i32, Vec<(Sample, String)>)> = drawn
-            .iter()
-            .enumerate()
-            .map(|(gi, (_, label))| {
-                (
-                    90 + 220 * gi as i32,
-                    vec![(Sample::Marker(gi, colour(gi)), label.clone())],
-                )
-            })
-            .collect();
-        draw_legend(&key, &columns, 15)?;
+        let (key, body) = root.split_vertically(key_h);
         let panels: Vec<DrawingArea<SVGBackend, Shift>> = body.split_evenly((n, 1));
         let ylabel = if data.weighted {
             "(e - model)/sigma_e"
         } else {
             "e - model"
         };
+        let mut any_dense = false;
         for (f, area) in set.fits.iter().zip(panels.iter()) {
             let rmax = f
                 .normalized_residuals
@@ -124,9 +122,33 @@ fn draw_residuals(data: &FitData, set: &FitSet, title: &str) -> Result<String, P
                         )
                     })
                     .collect();
-                draw_markers(&mut chart, &pts, gi, 3, c)?;
+                let shown = one_per_pixel(&chart, &pts);
+                if shown.len() > MAX_MARKERS {
+                    any_dense = true;
+                    draw_density(&mut chart, &pts, c)?;
+                } else {
+                    draw_markers(&mut chart, &shown, gi, 3, c)?;
+                }
             }
         }
+        // The key last: it names the density where a panel drew one.
+        let mut columns: Vec<(i32, Vec<(Sample, String)>)> = (0..KEY_COLUMNS.min(drawn.len()))
+            .map(|c| (90 + 220 * c as i32, Vec::new()))
+            .collect();
+        for (gi, (_, label)) in drawn.iter().enumerate() {
+            let sample = Sample::Marker(gi, colour(gi));
+            columns[gi % KEY_COLUMNS].1.push((sample, label.clone()));
+        }
+        if any_dense {
+            // Column 0 holds the first group of every row: the note goes on a row below them.
+            columns[0].1.push((
+                Sample::Text,
+                format!(
+                    "where over {MAX_MARKERS} positions: {BLOCK_PX} px squares shaded by log count"
+                ),
+            ));
+        }
+        draw_legend(&key, &columns, 15)?;
         root.present().map_err(svg_err)?;
     }
     Ok(buf)
