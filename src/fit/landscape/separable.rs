@@ -9,7 +9,7 @@ use std::sync::Arc;
 mod cell;
 mod grid;
 mod kernel;
-use cell::{CURVATURE, Cell, ROUND};
+use cell::{Cell, ROUND};
 
 /// For large data (see [`sums`]) the looseness of a cell (which axis to split) is estimated
 /// from every LOOSE_STRIDE-th point: it decides nothing about the cell (13, prime, so that data
@@ -154,12 +154,12 @@ impl<'a> Separable<'a> {
     }
 
     fn cell(&self, lo: [usize; 2], hi: [usize; 2]) -> Cell<'_> {
-        let mut q = [0.0; 2];
+        let mut h2 = [0.0; 2];
         let mut eps = [0.0; 2];
         for k in 0..2 {
             if self.active[k] {
                 let h = self.t[k][hi[k]] - self.t[k][lo[k]];
-                q[k] = CURVATURE[k] * h * h / 8.0;
+                h2[k] = h * h / 8.0;
                 eps[k] = self.slack + ROUND;
             }
         }
@@ -168,7 +168,7 @@ impl<'a> Separable<'a> {
             f1: self.row(0, hi[0]),
             g0: self.row(1, lo[1]),
             g1: self.row(1, hi[1]),
-            q,
+            h2,
             eps,
             slack: self.slack,
             min_rule: self.min_rule,

@@ -88,8 +88,9 @@ fn terms<const MIN: bool, const FIRST: bool, const SECOND: bool>(
     // The factors' bands (Cell::bands): half-width c + a t (1 - t), the quadratic one while q
     // is below the corner difference, else the constant one.
     let (df, dg) = (f1 - f0, g1 - g0);
+    let q = cell.q_at::<MIN>(f1);
     let band = |k: usize, d: f64| {
-        let (q, eps) = (cell.q[k], cell.eps[k]);
+        let (q, eps) = (q[k], cell.eps[k]);
         let quad = q <= d + eps;
         (sel(quad, eps, d + 2.0 * eps), sel(quad, 4.0 * q, 0.0))
     };

@@ -239,6 +239,55 @@ fn the_bound_is_second_order_in_the_cell_width() {
 }
 
 #[test]
+fn every_factor_lies_in_its_band_over_its_cell() {
+    // F's band rests on a curvature bound taken at each point's loss at the cell's far end
+    // (`Cell::q_at`): e_vm from 0.999 down to about 0.03 (eta from 1 to 3e4 on these points),
+    // and e_pm from below yield to far past it (sigma_y from 1e5 to 1e9 Pa), cells 1e-3 to 2
+    // wide in each log parameter. At 33 points inside each cell every point's factor, computed
+    // by the model, must lie within its band around the linear interpolant of its corner rows:
+    // |F(s) - (f0 + s (f1 - f0))| <= c + a s (1 - s), and likewise G in u. No tolerance: the
+    // band's c holds the factor's own error.
+    let d = data(40, true);
+    let ev = Evaluator::new(&d, ContactEnd::Overlap, VmMethod::Master);
+    let obj = Objective::new(&ev, ModelKind::Product).unwrap();
+    let mut quadratic = [0usize; 2];
+    for (c0, c1) in [
+        (0.0, 12.0),
+        (3.0, 14.0),
+        (5.2, 16.5),
+        (7.0, 17.5),
+        (10.3, 20.7),
+    ] {
+        for w in [1e-3, 0.05, 0.5, 2.0] {
+            let (lo, hi) = ([c0 - 0.5 * w, c1 - 0.5 * w], [c0 + 0.5 * w, c1 + 0.5 * w]);
+            let l = cell_landscape(&obj, lo, hi);
+            let cell = l.cell([0, 0], [1, 1]);
+            for j in 1..34 {
+                let s = j as f64 / 34.0;
+                let rows = [0, 1].map(|k| ev.row(k, lo[k] + s * (hi[k] - lo[k])));
+                for i in 0..d.len() {
+                    let bands = cell.bands(i);
+                    let ends = [(cell.f0[i], cell.f1[i]), (cell.g0[i], cell.g1[i])];
+                    for (k, (row, (a, b))) in rows.iter().zip(ends).enumerate() {
+                        let off = (row[i] - (a + s * (b - a))).abs();
+                        let band = bands[k].c + bands[k].a * s * (1.0 - s);
+                        assert!(
+                            off <= band,
+                            "axis {k}, cell {lo:?} {hi:?}, point {i}, s {s}: {off} > {band}"
+                        );
+                        if bands[k].a > 0.0 {
+                            quadratic[k] += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    // Both axes' quadratic bands were put to the test, not only the constant ones.
+    assert!(quadratic[0] > 1000 && quadratic[1] > 1000, "{quadratic:?}");
+}
+
+#[test]
 fn newton_steps_stay_in_the_cell_and_stop_without_curvature() {
     // A quadratic with its minimum at (0.8, 0.3) is reached in one step; one outside the cell
     // (at (1.5, 0.3), no correlation) is clipped to s = 1 with u re-minimised to 0.3; a model
