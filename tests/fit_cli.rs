@@ -579,8 +579,8 @@ fn figures_draw_a_marker_once_per_pixel_and_many_as_a_density() {
     let count = |svg: &str| {
         ["<circle", "<polygon", "<rect", "<line", "<polyline"].map(|t| svg.matches(t).count())
     };
-    let mut seen = Vec::new();
-    for (name, text) in [("once.csv", shipped.as_str()), ("x50.csv", &repeated)] {
+    // `fit --model vm --out` of `text` (written as `name`): its two figures.
+    let figures = |name: &str, text: &str| {
         let data = write(&dir, name, text);
         let out = dir.join(name.replace(".csv", ""));
         let r = run(&[
@@ -594,8 +594,12 @@ fn figures_draw_a_marker_once_per_pixel_and_many_as_a_density() {
             out.to_str().unwrap(),
         ]);
         assert!(r.ok, "{}", r.stderr);
-        let fig = std::fs::read_to_string(out.join("fig7.svg")).unwrap();
-        let res = std::fs::read_to_string(out.join("residuals.svg")).unwrap();
+        let read = |f: &str| std::fs::read_to_string(out.join(f)).unwrap();
+        (read("fig7.svg"), read("residuals.svg"))
+    };
+    let mut seen = Vec::new();
+    for (name, text) in [("once.csv", shipped.as_str()), ("x50.csv", &repeated)] {
+        let (fig, res) = figures(name, text);
         assert!(!fig.contains("density") && !res.contains("density"));
         seen.push((count(&fig), count(&res)));
     }
@@ -610,20 +614,7 @@ fn figures_draw_a_marker_once_per_pixel_and_many_as_a_density() {
         let e = 0.95 - 0.04 * v.ln() + 0.03 * ((k * 7919 % 1000) as f64 / 1000.0 - 0.5);
         csv += &format!("{},{},{v},{e},0.02\n", 5.0 + 1e-4 * k as f64, 6.0);
     }
-    let data = write(&dir, "spread.csv", &csv);
-    let out = dir.join("spread");
-    let r = run(&[
-        "fit",
-        &data,
-        "--material",
-        "nylon",
-        "--model",
-        "vm",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(r.ok, "{}", r.stderr);
-    let fig = std::fs::read_to_string(out.join("fig7.svg")).unwrap();
+    let (fig, res) = figures("spread.csv", &csv);
     assert!(
         fig.contains("data as density: 4 px squares shaded by log count (1 to ")
             && fig.contains("error bars left out"),
@@ -632,7 +623,6 @@ fn figures_draw_a_marker_once_per_pixel_and_many_as_a_density() {
     // The legend's one marker; the data are squares.
     assert_eq!(fig.matches("<circle").count(), 1);
     assert!(fig.matches("<rect").count() > 1000);
-    let res = std::fs::read_to_string(out.join("residuals.svg")).unwrap();
     assert!(res.contains("where over 5000 positions: 4 px squares shaded by log count"));
     assert_eq!(res.matches("<circle").count(), 1);
     let _ = std::fs::remove_dir_all(&dir);

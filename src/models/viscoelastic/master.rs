@@ -490,6 +490,24 @@ mod tests {
         }
     }
 
+    /// Calls `f(e, d2)` for both rules at every point of a grid of step h = 1e-3 in
+    /// t = ln kappa from `kappa_lo` to 1e12: e there and its second difference
+    /// (e(t + h) - 2 e(t) + e(t - h))/h^2, which must be finite.
+    fn second_differences(kappa_lo: f64, mut f: impl FnMut(f64, f64)) {
+        let h = 1e-3;
+        let (t0, t1) = (kappa_lo.ln(), 1e12f64.ln());
+        let steps = ((t1 - t0) / h) as usize;
+        for rule in [ContactEnd::Overlap, ContactEnd::Force] {
+            let e = |t: f64| restitution_master(t.exp(), rule).unwrap().e;
+            for k in 1..steps {
+                let t = t0 + k as f64 * h;
+                let d2 = (e(t + h) - 2.0 * e(t) + e(t - h)) / (h * h);
+                assert!(d2.is_finite(), "{rule:?} kappa {}", t.exp());
+                f(e(t), d2);
+            }
+        }
+    }
+
     #[test]
     fn curvature_in_ln_kappa_stays_below_its_bound_with_its_margin() {
         // Second differences (F(t + h) - 2 F(t) + F(t - h))/h^2, h = 1e-3, on a grid of step
@@ -498,19 +516,8 @@ mod tests {
         // the second derivative at a point within h of t, so the grid's maximum is the
         // function's to about h |F'''| (under 1e-3 here). That maximum must stay below the
         // bound over its stated margin 1.5, and be the 0.455 the doc quotes (to 1e-3).
-        let h = 1e-3;
-        let (t0, t1) = (1e-12f64.ln(), 1e12f64.ln());
-        let steps = ((t1 - t0) / h) as usize;
         let mut worst: f64 = 0.0;
-        for rule in [ContactEnd::Overlap, ContactEnd::Force] {
-            let e = |t: f64| restitution_master(t.exp(), rule).unwrap().e;
-            for k in 1..steps {
-                let t = t0 + k as f64 * h;
-                let d2 = (e(t + h) - 2.0 * e(t) + e(t - h)) / (h * h);
-                assert!(d2.is_finite(), "{rule:?} kappa {}", t.exp());
-                worst = worst.max(d2.abs());
-            }
-        }
+        second_differences(1e-12, |_, d2| worst = worst.max(d2.abs()));
         eprintln!("max |d2 e_vm / d(ln kappa)^2| = {worst}");
         assert!(
             worst <= E_CURVATURE_LN_KAPPA / 1.5,
@@ -526,22 +533,12 @@ mod tests {
         // most 4 x 2.4e-15 / h^2 = 1e-8, 1% of such a loss. Below (kappa < about 1e-6) the
         // ratio is 1 + O(kappa^(1/2)) analytically (the doc above). The maximum must be the
         // limit 1 (to 1%) and stay below the bound over its margin 1.5.
-        let h = 1e-3;
-        let (t0, t1) = (1e-8f64.ln(), 1e12f64.ln());
-        let steps = ((t1 - t0) / h) as usize;
         let mut worst: f64 = 0.0;
-        for rule in [ContactEnd::Overlap, ContactEnd::Force] {
-            let e = |t: f64| restitution_master(t.exp(), rule).unwrap().e;
-            for k in 1..steps {
-                let t = t0 + k as f64 * h;
-                let loss = 1.0 - e(t);
-                if loss < 1e-6 {
-                    continue;
-                }
-                let d2 = (e(t + h) - 2.0 * e(t) + e(t - h)) / (h * h);
-                worst = worst.max(d2.abs() / loss);
+        second_differences(1e-8, |e, d2| {
+            if 1.0 - e >= 1e-6 {
+                worst = worst.max(d2.abs() / (1.0 - e));
             }
-        }
+        });
         eprintln!("max |d2 e_vm / d(ln kappa)^2| / (1 - e) = {worst}");
         assert!(
             worst <= E_CURVATURE_PER_LOSS / 1.5,
