@@ -132,8 +132,9 @@ fn draw_fig7(
             ),
         ));
     }
-    // Each group's points, and whether they are drawn as a density (points.rs): the chart's
-    // pixels do not depend on the legend's height below it, so a scratch chart tells.
+    // Each group's points, one per pixel, and whether they are drawn as a density (points.rs):
+    // the chart's pixels do not depend on the legend's height below it, so a scratch chart of
+    // the same size tells, and its points are the ones the figure draws.
     let pts: Vec<Vec<(f64, f64)>> = groups
         .iter()
         .map(|g| {
@@ -144,14 +145,13 @@ fn draw_fig7(
                 .collect()
         })
         .collect();
-    let dense: Vec<bool> = {
+    let shown: Vec<Vec<(f64, f64)>> = {
         let mut scratch = String::new();
         let area = SVGBackend::with_string(&mut scratch, (980, 640)).into_drawing_area();
         let chart = chart_on(&area, title, x_range, y_range)?;
-        pts.iter()
-            .map(|p| one_per_pixel(&chart, p).len() > MAX_MARKERS)
-            .collect()
+        pts.iter().map(|p| one_per_pixel(&chart, p)).collect()
     };
+    let dense: Vec<bool> = shown.iter().map(|s| s.len() > MAX_MARKERS).collect();
     let notes = dense.iter().filter(|&&d| d).count();
     let legend_rows = (legend.len() + notes).max(data_key.len()) as u32;
     let legend_h = 24 + legend_rows * 26;
@@ -211,8 +211,7 @@ fn draw_fig7(
                 (o.e > 0.0).then_some((o.v_n_m_s, lo, o.e, hi))
             });
             draw_error_bars(&mut chart, bars, c.stroke_width(1), 6)?;
-            let shown = one_per_pixel(&chart, &pts[gi]);
-            draw_markers(&mut chart, &shown, gi, 4, c)?;
+            draw_markers(&mut chart, &shown[gi], gi, 4, c)?;
         }
         draw_legend(&bottom, &[(40, data_key), (260, legend)], 16)?;
         root.present().map_err(svg_err)?;
