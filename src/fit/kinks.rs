@@ -57,12 +57,35 @@ pub fn kink_starts(obj: &Objective, theta: &[f64], sd: [f64; 2]) -> Result<(Vec<
     let h = obj.fd_step;
     let mut out = Vec::new();
     let mut on_kink = false;
-    for i in 0..ev.len() {
-        let f = ev.e_vm(i, t0.exp())?;
-        let g = ev.e_pm(i, t1.exp());
+    // Each factor at its three values for every point as rows (the evaluations' vectorised
+    // path, the same doubles as point by point: on 100 000 points the scalar calls were 3% of
+    // a `min` fit). A NaN of e_vm's row is evaluated again alone, for its error.
+    let n = ev.len();
+    let eta = [t0.exp(), (t0 + h).exp(), (t0 - h).exp()];
+    let sigma = [t1.exp(), (t1 + h).exp(), (t1 - h).exp()];
+    let rows = |axis: usize, x: f64| {
+        let mut row = vec![0.0; n];
+        if axis == 0 {
+            ev.e_vm_row(x, &mut row);
+        } else {
+            ev.e_pm_row(x, &mut row);
+        }
+        row
+    };
+    let vm_rows = eta.map(|x| rows(0, x));
+    let pm_rows = sigma.map(|x| rows(1, x));
+    let vm = |k: usize, i: usize| -> Result<f64> {
+        match vm_rows[k][i] {
+            v if v.is_nan() => ev.e_vm(i, eta[k]),
+            v => Ok(v),
+        }
+    };
+    let [g_at, g_hi, g_lo] = &pm_rows;
+    for (i, ((&g, g_hi), g_lo)) in g_at.iter().zip(g_hi).zip(g_lo).enumerate() {
+        let f = vm(0, i)?;
         let convex = f.min(g) <= ev.data.obs[i].e;
-        let df = (ev.e_vm(i, (t0 + h).exp())? - ev.e_vm(i, (t0 - h).exp())?) / (2.0 * h);
-        let dg = (ev.e_pm(i, (t1 + h).exp()) - ev.e_pm(i, (t1 - h).exp())) / (2.0 * h);
+        let df = (vm(1, i)? - vm(2, i)?) / (2.0 * h);
+        let dg = (g_hi - g_lo) / (2.0 * h);
         let (gx, gy) = (df, -dg);
         let norm2 = gx * gx + gy * gy;
         let reach = ((gx * sd[0]).powi(2) + (gy * sd[1]).powi(2)).sqrt();

@@ -241,6 +241,9 @@ pub struct Evaluator<'a> {
     kappa_per_eta: Vec<f64>,
     /// V_Y at sigma_y = 1 Pa: V_Y ~ sigma_y^(5/2) (Eq. 15, [`Contact::yield_velocity_m_s`]).
     v_yield_per_pa: Vec<f64>,
+    /// The points' speeds, contiguous (read with `v_yield_per_pa` by every evaluation of e_pm;
+    /// from the observations' records they were a cache line per point).
+    v_n_m_s: Vec<f64>,
     /// ln(d/d_ref) and ln(v/v_ref) of the power law: 1 - e = exp(ln A - a x1 + b x2), one
     /// exp per point instead of two powf.
     powerlaw_ln_d: Vec<f64>,
@@ -304,6 +307,7 @@ impl<'a> Evaluator<'a> {
                 .iter()
                 .map(|c| c.yield_velocity_m_s(1.0))
                 .collect(),
+            v_n_m_s: data.obs.iter().map(|o| o.v_n_m_s).collect(),
             powerlaw_ln_d: data
                 .contacts
                 .iter()
@@ -392,10 +396,19 @@ impl<'a> Evaluator<'a> {
         });
     }
 
-    /// u = v / V_Y of point `i` given s25 = sigma_y^(5/2) (V_Y = V_Y per Pa^(5/2) x s25).
+    /// u = v / V_Y of the points `start..start + out.len()` given s25 = sigma_y^(5/2) (V_Y = V_Y
+    /// per Pa^(5/2) x s25), into `out` (read in sequence: several points at once where inlined
+    /// into a [`crate::cpu::fast`] caller).
     #[inline(always)]
-    pub(super) fn u_s25(&self, i: usize, s25: f64) -> f64 {
-        self.data.obs[i].v_n_m_s / (self.v_yield_per_pa[i] * s25)
+    pub(super) fn u_into(&self, start: usize, s25: f64, out: &mut [f64]) {
+        let at = start..start + out.len();
+        for ((u, v), vy) in out
+            .iter_mut()
+            .zip(&self.v_n_m_s[at.clone()])
+            .zip(&self.v_yield_per_pa[at])
+        {
+            *u = v / (vy * s25);
+        }
     }
 
     /// `combine(slot, e_pm)` for the points `start..start + out.len()` given s25 = sigma_y^(5/2)
@@ -410,9 +423,7 @@ impl<'a> Evaluator<'a> {
         for (b, slots) in out.chunks_mut(BLOCK).enumerate() {
             let at = start + b * BLOCK;
             let u = &mut u[..slots.len()];
-            for (j, x) in u.iter_mut().enumerate() {
-                *x = self.u_s25(at + j, s25);
-            }
+            self.u_into(at, s25, u);
             plastic::e_of_u_in_place(u);
             for (slot, e) in slots.iter_mut().zip(u.iter()) {
                 combine(slot, *e);
@@ -469,32 +480,41 @@ impl<'a> Evaluator<'a> {
             let m = block.len();
             let order = &self.kappa_order[base..base + m];
             // kappa(i, eta) of the points in order (buffers of the block's size: zeroing a
-            // whole chunk's would cost small data more than their evaluation).
-            let mut k: Vec<f64> = (self.kappa_per_eta_in_order[base..base + m].iter())
-                .map(|c| c * eta)
-                .collect();
-            let mut sk = vec![0.0; if slopes.is_some() { m } else { 0 }];
-            let done = match slopes {
-                Some(_) => master::e_and_slope_master_in_place(&mut k, &mut sk, self.rule),
-                None => master::e_master_in_place(&mut k, self.rule),
-            };
-            if let Err(pos) = done {
-                let first = (0..m)
-                    .find(|&j| {
-                        master::restitution_master(self.kappa(base + j, eta), self.rule).is_none()
-                    })
-                    .unwrap_or(order[pos] as usize);
-                return Err(self.master_refusal(base + first, eta));
-            }
-            for (k, &j) in k.iter().zip(order) {
-                block[j as usize] = *k;
-            }
-            if let Some(out) = slopes.as_deref_mut() {
-                let out = &mut out[b * sums::CHUNK..b * sums::CHUNK + m];
-                for (s, &j) in sk.iter().zip(order) {
-                    out[j as usize] = *s;
+            // whole chunk's would cost small data more than their evaluation; lent by the
+            // thread, not allocated per block).
+            let with_slopes = slopes.is_some();
+            sums::with_scratch(m, [0.0, 0.0], |[k, sk]| {
+                for (k, c) in k
+                    .iter_mut()
+                    .zip(&self.kappa_per_eta_in_order[base..base + m])
+                {
+                    *k = c * eta;
                 }
-            }
+                let done = if with_slopes {
+                    master::e_and_slope_master_in_place(k, sk, self.rule)
+                } else {
+                    master::e_master_in_place(k, self.rule)
+                };
+                if let Err(pos) = done {
+                    let first = (0..m)
+                        .find(|&j| {
+                            master::restitution_master(self.kappa(base + j, eta), self.rule)
+                                .is_none()
+                        })
+                        .unwrap_or(order[pos] as usize);
+                    return Err(self.master_refusal(base + first, eta));
+                }
+                for (k, &j) in k.iter().zip(order) {
+                    block[j as usize] = *k;
+                }
+                if let Some(out) = slopes.as_deref_mut() {
+                    let out = &mut out[b * sums::CHUNK..b * sums::CHUNK + m];
+                    for (s, &j) in sk.iter().zip(order) {
+                        out[j as usize] = *s;
+                    }
+                }
+                Ok(())
+            })?;
         }
         Ok(())
     }

@@ -234,19 +234,20 @@ impl<'a> Objective<'a> {
             }
         });
         let cols = (0..3).filter(|&j| free[j]);
-        for (c, j) in cols.enumerate() {
-            let mut col = out.column_mut(c);
-            match j {
-                0 => col.iter_mut().zip(&q).for_each(|(o, q)| *o = -q),
-                1 => col
-                    .iter_mut()
-                    .zip(q.iter().zip(x1))
-                    .for_each(|(o, (q, x))| *o = q * x),
-                _ => col
-                    .iter_mut()
-                    .zip(q.iter().zip(x2))
-                    .for_each(|(o, (q, x))| *o = -q * x),
-            }
+        // Each column in chunks side by side (large data), as slices read in sequence.
+        for (col, j) in out.as_mut_slice().chunks_mut(n.max(1)).zip(cols) {
+            super::sums::fill_chunks(col, |start, o| {
+                let at = start..start + o.len();
+                let q = &q[at.clone()];
+                match j {
+                    0 => o.iter_mut().zip(q).for_each(|(o, q)| *o = -q),
+                    1 => {
+                        (o.iter_mut().zip(q.iter().zip(&x1[at]))).for_each(|(o, (q, x))| *o = q * x)
+                    }
+                    _ => (o.iter_mut().zip(q.iter().zip(&x2[at])))
+                        .for_each(|(o, (q, x))| *o = -q * x),
+                }
+            });
         }
     }
 

@@ -461,6 +461,9 @@ impl Separable<'_> {
         self.rows[axis].push(Arc::clone(&row));
         // The first point that failed names the failure (the evaluation's error if it gave
         // one, else the NaN).
+        if !crate::cpu::fast(|| has_nan(&row)) {
+            return Ok(());
+        }
         let Some(i) = row.iter().position(|v| v.is_nan()) else {
             return Ok(());
         };
@@ -500,6 +503,14 @@ impl Separable<'_> {
             loose: [l0, l1],
         }
     }
+}
+
+/// Whether any value is NaN: blocks without an early exit (a loop the compiler runs several
+/// values at once, where a search for the first NaN went value by value over every row).
+#[inline(always)]
+fn has_nan(row: &[f64]) -> bool {
+    row.chunks(256)
+        .any(|b| b.iter().fold(false, |a, v| a | v.is_nan()))
 }
 
 /// Point i's first-order looseness per axis: how far its corner products move along each axis,

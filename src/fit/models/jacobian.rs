@@ -13,6 +13,7 @@
 //! **Known answer**: the test below compares it with central differences for every model, both
 //! contact rules and every set of free parameters.
 
+use super::super::sums;
 use super::{Evaluator, ModelKind};
 use crate::error::{Error, Result};
 use crate::models::plastic;
@@ -90,7 +91,7 @@ impl Evaluator<'_> {
         let held = match (kind, slope) {
             // One axis free: the other (1 where axis 0 is free) is held, at p[h].
             (ModelKind::Min | ModelKind::Product, [free0, free1])
-                if free0 != free1 && super::super::sums::is_large(n) =>
+                if free0 != free1 && sums::is_large(n) =>
             {
                 let h = usize::from(free0);
                 self.held_row(h, p[h]).map(|r| (h, r))
@@ -103,53 +104,36 @@ impl Evaluator<'_> {
         };
         let chunk = |start: usize, c0: &mut [f64], c1: &mut [f64], f: &mut [f64]| -> Result<()> {
             let m = c0.len();
-            let (mut ev, mut sv) = (vec![1.0; m], vec![0.0; m]);
-            if let Some(row) = held_rows(0, start..start + m) {
-                ev.copy_from_slice(row);
-            } else if kind != ModelKind::Pm {
-                self.vm_in_kappa_order(start, eta, &mut ev, slope[0].then_some(&mut sv[..]))?;
-            }
-            // e_pm and its slope in ln u (times d ln u/d ln sigma_y = -5/2 below) four points
-            // at a time: the same doubles as point by point.
-            let (mut ep, mut sp) = (vec![1.0; m], vec![0.0; m]);
-            if let Some(row) = held_rows(1, start..start + m) {
-                ep.copy_from_slice(row);
-            } else if kind != ModelKind::Vm {
-                for (j, u) in ep.iter_mut().enumerate() {
-                    *u = self.u_s25(start + j, s25);
+            // An absent factor is 1 with slope 0: its products below are exact.
+            sums::with_scratch(m, [1.0, 0.0, 1.0, 0.0], |[ev, sv, ep, sp]| {
+                if let Some(row) = held_rows(0, start..start + m) {
+                    ev.copy_from_slice(row);
+                } else if kind != ModelKind::Pm {
+                    self.vm_in_kappa_order(start, eta, ev, slope[0].then_some(&mut sv[..]))?;
                 }
-                if slope[1] {
-                    plastic::e_and_slope_ln_u_in_place(&mut ep, &mut sp);
-                } else {
-                    plastic::e_of_u_in_place(&mut ep);
+                // e_pm and its slope in ln u (times d ln u/d ln sigma_y = -5/2 below) four
+                // points at a time: the same doubles as point by point.
+                if let Some(row) = held_rows(1, start..start + m) {
+                    ep.copy_from_slice(row);
+                } else if kind != ModelKind::Vm {
+                    crate::cpu::fast(|| self.u_into(start, s25, ep));
+                    if slope[1] {
+                        plastic::e_and_slope_ln_u_in_place(ep, sp);
+                    } else {
+                        plastic::e_of_u_in_place(ep);
+                    }
                 }
-            }
-            for j in 0..m {
-                let i = start + j;
-                let w = inv_sigma[i];
-                let (ep, sp) = (ep[j], -2.5 * sp[j]);
-                let d = match kind {
-                    ModelKind::Min if ev[j] < ep => [sv[j], 0.0],
-                    ModelKind::Min if ep < ev[j] => [0.0, sp],
-                    ModelKind::Min => [0.5 * sv[j], 0.5 * sp],
-                    _ => [ep * sv[j], ev[j] * sp],
+                let factors = Factors {
+                    ev,
+                    sv,
+                    ep,
+                    sp,
+                    w: &inv_sigma[start..start + m],
+                    e_obs: e_obs.get(start..start + m).unwrap_or(&[]),
                 };
-                c0[j] = d[axes[0]] * w;
-                if let Some(&a) = axes.get(1) {
-                    c1[j] = d[a] * w;
-                }
-                if let Some(fj) = f.get_mut(j) {
-                    // As [`Evaluator::predict_then`] and the objective's residuals form it.
-                    let model = match kind {
-                        ModelKind::Vm => ev[j],
-                        ModelKind::Pm => ep,
-                        ModelKind::Min => ev[j].min(ep),
-                        _ => ev[j] * ep,
-                    };
-                    *fj = (model - e_obs[i]) * w;
-                }
-            }
-            Ok(())
+                crate::cpu::fast(|| factors.columns(kind == ModelKind::Min, &axes, c0, c1, f));
+                Ok(())
+            })
         };
         if axes.is_empty() {
             if !f_out.is_empty() {
@@ -161,11 +145,11 @@ impl Evaluator<'_> {
             }
             return Ok(());
         }
-        if !super::super::sums::is_large(n) {
+        if !sums::is_large(n) {
             return chunk(0, c0, c1, f_out);
         }
         use rayon::prelude::*;
-        let size = super::super::sums::CHUNK;
+        let size = sums::CHUNK;
         // Empty slices (no second column, no residuals) pair with every chunk as empty pieces.
         fn pieces(v: &mut [f64], n: usize, size: usize) -> Vec<&mut [f64]> {
             if v.is_empty() {
@@ -182,6 +166,91 @@ impl Evaluator<'_> {
             .map(|(c, ((a, b), f))| crate::cpu::fast(|| chunk(c * size, a, b, f)))
             .collect();
         results.into_iter().collect()
+    }
+}
+
+/// One chunk's factors (e_vm, its slope in ln kappa, e_pm, its slope in ln u; an absent
+/// factor 1 with slope 0), the points' weights 1/sigma and observed e (empty without
+/// residuals).
+struct Factors<'a> {
+    ev: &'a [f64],
+    sv: &'a [f64],
+    ep: &'a [f64],
+    sp: &'a [f64],
+    w: &'a [f64],
+    e_obs: &'a [f64],
+}
+
+impl Factors<'_> {
+    /// The columns of the free axes (`axes`: 0 for e_vm's parameter, 1 for e_pm's) into `c0`
+    /// and `c1`, and the weighted residuals into `f` unless it is empty. `product` (and `vm`,
+    /// `pm`, whose absent factor is 1): the product rule; `min`: the smaller factor's
+    /// derivative, at an exact tie the mean of the two. One loop instance per case, without a
+    /// branch per point, so that it runs several points at once (inlined into a
+    /// [`crate::cpu::fast`] caller).
+    #[inline(always)]
+    fn columns(&self, min: bool, axes: &[usize], c0: &mut [f64], c1: &mut [f64], f: &mut [f64]) {
+        let two = axes.len() == 2;
+        let second = axes[0] == 1;
+        match (min, two, f.is_empty()) {
+            (false, false, true) => self.columns_as::<false, false, false>(second, c0, c1, f),
+            (false, false, false) => self.columns_as::<false, false, true>(second, c0, c1, f),
+            (false, true, true) => self.columns_as::<false, true, false>(second, c0, c1, f),
+            (false, true, false) => self.columns_as::<false, true, true>(second, c0, c1, f),
+            (true, false, true) => self.columns_as::<true, false, false>(second, c0, c1, f),
+            (true, false, false) => self.columns_as::<true, false, true>(second, c0, c1, f),
+            (true, true, true) => self.columns_as::<true, true, false>(second, c0, c1, f),
+            (true, true, false) => self.columns_as::<true, true, true>(second, c0, c1, f),
+        }
+    }
+
+    #[inline(always)]
+    fn columns_as<const MIN: bool, const TWO: bool, const RES: bool>(
+        &self,
+        second: bool,
+        c0: &mut [f64],
+        c1: &mut [f64],
+        f: &mut [f64],
+    ) {
+        let m = c0.len();
+        let (ev, sv, ep, sp, w) = (
+            &self.ev[..m],
+            &self.sv[..m],
+            &self.ep[..m],
+            &self.sp[..m],
+            &self.w[..m],
+        );
+        let c1 = if TWO { &mut c1[..m] } else { &mut [][..] };
+        let (f, e_obs) = if RES {
+            (&mut f[..m], &self.e_obs[..m])
+        } else {
+            (&mut [][..], &[][..])
+        };
+        let sel = |c: bool, a: f64, b: f64| if c { a } else { b };
+        for j in 0..m {
+            let (a, sa, b, sb) = (ev[j], sv[j], ep[j], -2.5 * sp[j]);
+            let d = if MIN {
+                let (lt, gt) = (a < b, b < a);
+                [
+                    sel(lt, sa, sel(gt, 0.0, 0.5 * sa)),
+                    sel(lt, 0.0, sel(gt, sb, 0.5 * sb)),
+                ]
+            } else {
+                [b * sa, a * sb]
+            };
+            if TWO {
+                c0[j] = d[0] * w[j];
+                c1[j] = d[1] * w[j];
+            } else {
+                c0[j] = sel(second, d[1], d[0]) * w[j];
+            }
+            if RES {
+                // As [`Evaluator::predict_then`] and the objective's residuals form it (with
+                // an absent factor 1: x 1 is exact).
+                let model = if MIN { a.min(b) } else { a * b };
+                f[j] = (model - e_obs[j]) * w[j];
+            }
+        }
     }
 }
 

@@ -523,3 +523,17 @@ fn a_grid_of_nodes_is_each_node_alone_bit_for_bit() {
         }
     }
 }
+
+/// The rows' NaN scan finds a NaN wherever it is (first, inside a block, in a short last block)
+/// and none in a row without one.
+#[test]
+fn a_nan_anywhere_in_a_row_is_found() {
+    let n = 1000;
+    assert!(!has_nan(&vec![0.5; n]));
+    assert!(!has_nan(&[]));
+    for at in [0, 1, 255, 256, 700, 999] {
+        let mut row = vec![0.5; n];
+        row[at] = f64::NAN;
+        assert!(has_nan(&row), "{at}");
+    }
+}
