@@ -483,7 +483,8 @@ impl<'a> Evaluator<'a> {
             // whole chunk's would cost small data more than their evaluation; lent by the
             // thread, not allocated per block).
             let with_slopes = slopes.is_some();
-            sums::with_scratch(m, [0.0, 0.0], |[k, sk]| {
+            // Both written in full before they are read.
+            sums::with_scratch(m, [None, None], |[k, sk]| {
                 for (k, c) in k
                     .iter_mut()
                     .zip(&self.kappa_per_eta_in_order[base..base + m])

@@ -22,7 +22,7 @@
 
 use super::dataset::{FitData, Merged};
 use super::lsq::Residuals;
-use super::models::{Evaluator, ModelKind, POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S, powerlaw_d_mm};
+use super::models::{Evaluator, ModelKind};
 use crate::error::{Error, Result};
 use crate::models::viscoelastic::{Integrator, VmMethod, master::KAPPA_MAX};
 use nalgebra::DMatrix;
@@ -391,18 +391,8 @@ fn search_box(
         }
         ModelKind::PowerLaw => {
             let (a_lo, a_hi) = (1e-9f64.ln(), 1e3f64.ln());
-            let x: Vec<[f64; 2]> = ev
-                .data
-                .obs
-                .iter()
-                .zip(&ev.data.contacts)
-                .map(|(o, c)| {
-                    [
-                        (powerlaw_d_mm(c) / POWERLAW_D_REF_MM).ln(),
-                        (o.v_n_m_s / POWERLAW_V_REF_M_S).ln(),
-                    ]
-                })
-                .collect();
+            let (x1, x2) = ev.powerlaw_logs();
+            let x: Vec<[f64; 2]> = x1.iter().zip(x2).map(|(&a, &b)| [a, b]).collect();
             let ends = powerlaw_exponent_ends(&x, a_lo, a_hi)?;
             if ends != [-10.0, 10.0, -10.0, 10.0] {
                 warnings.push(format!(

@@ -8,7 +8,6 @@
 //! true exponents is the true A.
 
 use super::lsq::{self, LmOptions, Residuals};
-use super::models::{POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S, powerlaw_d_mm};
 use super::objective::Objective;
 use super::polish::Found;
 use super::{sums, vexp};
@@ -19,8 +18,9 @@ use crate::error::Result;
 /// exact minimum over the box).
 pub struct ProfiledPowerLaw<'a> {
     obj: &'a Objective<'a>,
-    x1: Vec<f64>,
-    x2: Vec<f64>,
+    /// The evaluator's ln(d/d_ref) and ln(v/v_ref).
+    x1: &'a [f64],
+    x2: &'a [f64],
     y: Vec<f64>,
     /// The weights 1/sigma_i^2 scaled by the largest (the sums of [`ProfiledPowerLaw::ln_a`]).
     w: Vec<f64>,
@@ -32,18 +32,11 @@ impl<'a> ProfiledPowerLaw<'a> {
     pub fn new(obj: &'a Objective<'a>) -> Self {
         let data = obj.ev.data;
         let wmax = obj.inv_sigma.iter().map(|s| s * s).fold(0.0, f64::max);
+        let (x1, x2) = obj.ev.powerlaw_logs();
         ProfiledPowerLaw {
             obj,
-            x1: data
-                .contacts
-                .iter()
-                .map(|c| (powerlaw_d_mm(c) / POWERLAW_D_REF_MM).ln())
-                .collect(),
-            x2: data
-                .obs
-                .iter()
-                .map(|o| (o.v_n_m_s / POWERLAW_V_REF_M_S).ln())
-                .collect(),
+            x1,
+            x2,
             y: data.obs.iter().map(|o| 1.0 - o.e).collect(),
             w: obj.inv_sigma.iter().map(|s| s * s / wmax).collect(),
             lower: obj.lower[1..].to_vec(),
@@ -56,7 +49,7 @@ impl<'a> ProfiledPowerLaw<'a> {
     /// [`sums::sum`]'s: in point order for small data, in fixed chunks for large data, so the
     /// result never depends on the number of threads.
     pub fn ln_a(&self, ab: &[f64]) -> f64 {
-        let (x1, x2, y, w) = (&self.x1, &self.x2, &self.y, &self.w);
+        let (x1, x2, y, w) = (self.x1, self.x2, &self.y, &self.w);
         let n = y.len();
         let mut z = vec![0.0; n];
         sums::fill_chunks(&mut z, |start, z| {

@@ -81,22 +81,30 @@ thread_local! {
     static SCRATCH: std::cell::RefCell<Vec<Vec<f64>>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
-/// `f` with K buffers of `len` values each, every value set to `init[k]`, lent by the calling
-/// thread and kept for its next call. Why: the per-chunk buffers of the Jacobian and of the
-/// master curve's evaluations were allocated afresh, zeroed by the allocator and freed at each
-/// chunk of each pass (a fifth of the exact Jacobian's time on 100 000 points, page faults
-/// included); a thread's buffers are warm in its cache. A nested call (from `f`, or from a
-/// task rayon runs on this thread meanwhile) finds the buffers lent and makes its own.
+/// `f` with K buffers of `len` values each, lent by the calling thread and kept for its next
+/// call: buffer k set to `init[k]` everywhere, or with `None` holding whatever it held (finite
+/// or not: for a buffer `f` writes in full before reading). Why: the per-chunk buffers of the
+/// Jacobian and of the master curve's evaluations were allocated afresh, zeroed by the
+/// allocator and freed at each chunk of each pass (a fifth of the exact Jacobian's time on
+/// 100 000 points, page faults included); a thread's buffers are warm in its cache, and
+/// filling those that are written anyway cost a tenth of the Jacobian again. A nested call
+/// (from `f`, or from a task rayon runs on this thread meanwhile) finds the buffers lent and
+/// makes its own.
 pub fn with_scratch<const K: usize, R>(
     len: usize,
-    init: [f64; K],
+    init: [Option<f64>; K],
     f: impl FnOnce(&mut [Vec<f64>; K]) -> R,
 ) -> R {
     let mut bufs: [Vec<f64>; K] =
         SCRATCH.with(|s| std::array::from_fn(|_| s.borrow_mut().pop().unwrap_or_default()));
     for (b, v) in bufs.iter_mut().zip(init) {
-        b.clear();
-        b.resize(len, v);
+        match v {
+            Some(v) => {
+                b.clear();
+                b.resize(len, v);
+            }
+            None => b.resize(len, f64::NAN),
+        }
     }
     let r = f(&mut bufs);
     SCRATCH.with(|s| s.borrow_mut().extend(bufs));
@@ -153,16 +161,16 @@ mod tests {
         assert_eq!(c[0], (n * (n - 1) / 2) as f64);
     }
 
-    /// Lent buffers hold their initial values whatever the last call left in them, and a
-    /// nested call gets buffers of its own.
+    /// Lent buffers given a value hold it whatever the last call left in them, those without
+    /// one the last values, and a nested call gets buffers of its own.
     #[test]
     fn scratch_buffers_start_at_their_values_and_nest() {
-        with_scratch(100, [1.0, 0.0], |[a, b]| {
+        with_scratch(100, [Some(1.0), Some(0.0)], |[a, b]| {
             a.fill(7.0);
             b.fill(8.0);
         });
-        let seen = with_scratch(50, [2.0, -3.0], |[a, b]| {
-            let inner = with_scratch(10, [4.0], |[c]| {
+        let seen = with_scratch(50, [Some(2.0), Some(-3.0)], |[a, b]| {
+            let inner = with_scratch(10, [Some(4.0)], |[c]| {
                 c[0] = 5.0;
                 c.clone()
             });
@@ -175,6 +183,16 @@ mod tests {
         assert_eq!(seen.1, vec![-3.0; 50]);
         assert_eq!(seen.2[0], 5.0);
         assert!(seen.2[1..].iter().all(|&x| x == 4.0) && seen.2.len() == 10);
+        // Without a value, the length is set and the values are left: the last call's two
+        // buffers (in either order) where they were that long, NaN beyond.
+        let (p, q) = with_scratch(60, [None, None], |[a, b]| (a.clone(), b.clone()));
+        assert_eq!((p.len(), q.len()), (60, 60));
+        let (p50, q50) = (p[..50].to_vec(), q[..50].to_vec());
+        assert!(
+            (p50 == seen.0 && q50 == seen.1) || (p50 == seen.1 && q50 == seen.0),
+            "{p50:?} {q50:?}"
+        );
+        assert!(p[50..].iter().chain(&q[50..]).all(|x| x.is_nan()));
     }
 
     #[test]

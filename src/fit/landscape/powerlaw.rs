@@ -2,7 +2,7 @@
 //! bound is in the parent module's documentation, its tests beside the separable models' there.
 
 use super::super::bnb::{Bound, Landscape};
-use super::super::models::{Evaluator, POWERLAW_D_REF_MM, POWERLAW_V_REF_M_S, powerlaw_d_mm};
+use super::super::models::Evaluator;
 use super::super::objective::{Objective, chi2_rounding};
 use super::super::{sums, vexp};
 use lanes::{load, store};
@@ -76,16 +76,9 @@ impl<'a> PowerLaw<'a> {
     pub fn new(obj: &Objective<'a>) -> Self {
         let data = obj.ev.data;
         let n = data.len();
-        let x1: Vec<f64> = data
-            .contacts
-            .iter()
-            .map(|c| (powerlaw_d_mm(c) / POWERLAW_D_REF_MM).ln())
-            .collect();
-        let x2: Vec<f64> = data
-            .obs
-            .iter()
-            .map(|o| (o.v_n_m_s / POWERLAW_V_REF_M_S).ln())
-            .collect();
+        // The evaluator's logs (computed once per fit; a landscape is made per search, slice
+        // and end).
+        let (x1, x2) = obj.ev.powerlaw_logs();
         let m1 = x1.iter().sum::<f64>() / n as f64;
         let m2 = x2.iter().sum::<f64>() / n as f64;
         let w: Vec<f64> = obj.inv_sigma.iter().map(|s| s * s).collect();

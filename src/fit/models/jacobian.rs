@@ -104,8 +104,15 @@ impl Evaluator<'_> {
         };
         let chunk = |start: usize, c0: &mut [f64], c1: &mut [f64], f: &mut [f64]| -> Result<()> {
             let m = c0.len();
-            // An absent factor is 1 with slope 0: its products below are exact.
-            sums::with_scratch(m, [1.0, 0.0, 1.0, 0.0], |[ev, sv, ep, sp]| {
+            // An absent factor is 1 with slope 0 (its products below are exact), a slope not
+            // computed 0; the others are written in full below.
+            let init = [
+                (kind == ModelKind::Pm).then_some(1.0),
+                (!slope[0]).then_some(0.0),
+                (kind == ModelKind::Vm).then_some(1.0),
+                (!slope[1]).then_some(0.0),
+            ];
+            sums::with_scratch(m, init, |[ev, sv, ep, sp]| {
                 if let Some(row) = held_rows(0, start..start + m) {
                     ev.copy_from_slice(row);
                 } else if kind != ModelKind::Pm {
