@@ -62,9 +62,10 @@ pub trait Residuals {
     /// The residuals into `out` and, in the same pass, the exact Jacobian at the same `theta`
     /// into `jac` (as [`Residuals::jacobian_exact`] gives it, to the last bit), where together
     /// they cost little more than the residuals alone: Levenberg-Marquardt asks for this at
-    /// trial points, where it needs the Jacobian whenever it accepts the step; `jac` comes
-    /// with its shape (n x free parameters) and stale values, and `Some(Ok(()))` promises that
-    /// every entry was written. `None` (the default): nothing was written,
+    /// trial points, where it needs the Jacobian whenever it accepts the step. `jac` comes with
+    /// stale values, and with its shape (n x free parameters) or none (0 x 0: the implementation
+    /// then makes it, so that a problem that declines costs no matrix); `Some(Ok(()))` promises
+    /// that every entry was written. `None` (the default): nothing was written,
     /// [`Residuals::residuals`] serves.
     fn residuals_and_jacobian(
         &self,
@@ -346,7 +347,26 @@ pub fn levenberg_marquardt_to(
         .map(|(j, &t)| t.clamp(lo[j], hi[j]))
         .collect();
     let mut f = vec![0.0; n];
-    residuals_checked(p, &theta, &mut f)?;
+    // The first Jacobian in the same pass as the residuals where the problem fuses them (one
+    // evaluation of the model where the residuals and then the Jacobian took two; the same
+    // numbers, see [`Residuals::residuals_and_jacobian`]).
+    let n_free = free.iter().filter(|&&b| b).count();
+    let mut jac_next: Option<DMatrix<f64>> = None;
+    let mut fuses = true;
+    let mut jac = DMatrix::zeros(0, 0);
+    match p.residuals_and_jacobian(&theta, &mut f, free, &mut jac) {
+        Some(done) => {
+            done?;
+            if f.iter().any(|x| x.is_nan()) {
+                return Err(nan_residual(&theta));
+            }
+            jac_next = Some(jac);
+        }
+        None => {
+            fuses = false;
+            residuals_checked(p, &theta, &mut f)?;
+        }
+    }
     let mut chi2v: f64 = sum_squares(&f);
     let outcome = |theta: Vec<f64>, chi2: f64, it: usize, conv: bool, reason| LmOutcome {
         theta,
@@ -372,13 +392,10 @@ pub fn levenberg_marquardt_to(
     let mut f_new = vec![0.0; n];
     let mut need_jac = true;
     // The Jacobian at the last trial point, when the problem gave it with the residuals.
-    let n_free = free.iter().filter(|&&b| b).count();
     let mut jac_trial = DMatrix::zeros(0, 0);
-    let mut jac_next: Option<DMatrix<f64>> = None;
     // The last Jacobian used, its storage lent to the next trial point's (a matrix of n rows
     // allocated and zeroed at every trial cost a tenth of the iteration on 100 000 points).
     let mut spare = DMatrix::zeros(0, 0);
-    let mut fuses = true;
     // J^T J over the parameters free for the step (computed once per Jacobian).
     let mut a = DMatrix::zeros(0, 0);
     let mut free_now: Vec<bool> = free.to_vec();

@@ -129,6 +129,10 @@ impl Residuals for Objective<'_> {
         if !self.ev.has_exact_jacobian(k) || !free.contains(&true) {
             return None;
         }
+        let shape = (self.ev.len(), free.iter().filter(|&&f| f).count());
+        if jac.shape() != shape {
+            *jac = DMatrix::zeros(shape.0, shape.1);
+        }
         self.count_evaluation();
         let p = k.to_physical(theta);
         Some(self.ev.jacobian_separable_with(
