@@ -160,7 +160,11 @@ pub(crate) fn e_of_u_lanes(values: &mut [f64]) {
     for g in &mut groups {
         let u = [g[0], g[1], g[2], g[3]];
         if u.iter().all(|&x| x > 1.0 && x < U_ASYMPTOTE) {
-            g.copy_from_slice(&u.map(|x| closed_form(x).0));
+            // A loop, not the array's `map`: its closure was not always inlined (then it ran
+            // as baseline code under the AVX2 caller).
+            for (g, &x) in g.iter_mut().zip(&u) {
+                *g = closed_form(x).0;
+            }
         } else if u.iter().all(|&x| x <= 1.0) {
             g.fill(1.0);
         } else {
@@ -247,12 +251,10 @@ pub(crate) fn e_and_slope_lanes(values: &mut [f64], slopes: &mut [f64]) {
     for (g, o) in (&mut groups).zip(&mut out) {
         let u = [g[0], g[1], g[2], g[3]];
         if u.iter().all(|&x| x > 1.0 && x < U_ASYMPTOTE) {
-            let r = u.map(|x| {
-                let (e, w) = closed_form(x);
-                closed_form_slope(x, e, w)
-            });
+            // A loop, not the array's `map` (see e_of_u_lanes).
             for k in 0..LANES {
-                (g[k], o[k]) = r[k];
+                let (e, w) = closed_form(u[k]);
+                (g[k], o[k]) = closed_form_slope(u[k], e, w);
             }
         } else if u.iter().all(|&x| x <= 1.0) {
             g.fill(1.0);
