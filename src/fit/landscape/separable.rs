@@ -233,7 +233,7 @@ impl<'a> Separable<'a> {
             v
         } else {
             sums::sum(self.n, |points| {
-                Self::part_fast::<MIN, FIRST, SECOND>(cell, e, w, x, points, with_loose)
+                part_fast::<MIN, FIRST, SECOND>(cell, e, w, x, points, with_loose)
             })
         };
         PassSums {
@@ -245,42 +245,6 @@ impl<'a> Separable<'a> {
             loose1: [v[9], v[10]],
             loose2: [v[11], v[12]],
         }
-    }
-
-    /// [`Separable::part_as`] run by a copy compiled for AVX2 and FMA where the processor has
-    /// them: inside [`crate::cpu::fast`] (as [`sums::sum`] calls it) the closure calling it was
-    /// not always inlined into the wrapper, and then ran as baseline code (3% of `--model all`
-    /// on 100 000 points of distinct sizes, after an unrelated change moved the inliner's
-    /// choices). The same operations either way, so the same bits ([`crate::cpu`]).
-    fn part_fast<const MIN: bool, const FIRST: bool, const SECOND: bool>(
-        cell: &Cell,
-        e: &[f64],
-        w: &[f64],
-        x: [f64; 2],
-        points: std::ops::Range<usize>,
-        with_loose: bool,
-    ) -> [f64; 13] {
-        #[cfg(target_arch = "x86_64")]
-        if crate::cpu::uses_avx2_fma() {
-            // SAFETY: the processor has the features the copy is compiled for.
-            return unsafe {
-                Self::part_avx2_fma::<MIN, FIRST, SECOND>(cell, e, w, x, points, with_loose)
-            };
-        }
-        Self::part_as::<MIN, FIRST, SECOND>(cell, e, w, x, points, with_loose)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,fma")]
-    unsafe fn part_avx2_fma<const MIN: bool, const FIRST: bool, const SECOND: bool>(
-        cell: &Cell,
-        e: &[f64],
-        w: &[f64],
-        x: [f64; 2],
-        points: std::ops::Range<usize>,
-        with_loose: bool,
-    ) -> [f64; 13] {
-        Self::part_as::<MIN, FIRST, SECOND>(cell, e, w, x, points, with_loose)
     }
 
     /// A pass's sums over `points` (consecutive, summed in order), in `pass_as`'s order; inlined
@@ -539,6 +503,20 @@ impl Separable<'_> {
             loose: [l0, l1],
         }
     }
+}
+
+crate::cpu::wide_copy! {
+    /// A full pass's sums over `points` ([`Separable::part_as`]) through a copy compiled for
+    /// AVX2 ([`crate::cpu::wide_copy`]: its closure inside `cpu::fast` had been left out of the
+    /// wrapper, 3% of `--model all` on 100 000 points of distinct sizes).
+    fn part_fast<const MIN: bool, const FIRST: bool, const SECOND: bool>(
+        cell: &Cell,
+        e: &[f64],
+        w: &[f64],
+        x: [f64; 2],
+        points: std::ops::Range<usize>,
+        with_loose: bool,
+    ) -> [f64; 13] = Separable::part_as;
 }
 
 /// Whether any value is NaN: blocks without an early exit (a loop the compiler runs several

@@ -69,64 +69,27 @@ fn in_chunks(
     total
 }
 
-// The sums below run as copies of their own compiled for AVX2 and FMA where
-// [`crate::cpu::uses_avx2_fma`]: inside [`crate::cpu::fast`] the closures calling them were too
-// large to be inlined into its wrapper and ran as baseline code (a tenth of `product`'s
-// instructions on 100 000 points of distinct sizes). The same operations either way (see
-// [`crate::cpu`]), so the same bits.
-
 type Pairs<'a, 'b> = &'a [(&'b [f64], &'b [f64])];
 
-fn list_part_fast<const MIN: bool>(
-    pairs: Pairs,
-    e: &[f64],
-    w: &[f64],
-    r: std::ops::Range<usize>,
-) -> Vec<f64> {
-    #[cfg(target_arch = "x86_64")]
-    if crate::cpu::uses_avx2_fma() {
-        // SAFETY: the processor has the features the copy is compiled for.
-        return unsafe { list_part_avx2_fma::<MIN>(pairs, e, w, r) };
-    }
-    list_part::<MIN>(pairs, e, w, r)
+crate::cpu::wide_copy! {
+    /// [`list_part`] through a copy compiled for AVX2 ([`crate::cpu::wide_copy`]).
+    fn list_part_fast<const MIN: bool>(
+        pairs: Pairs,
+        e: &[f64],
+        w: &[f64],
+        r: std::ops::Range<usize>,
+    ) -> Vec<f64> = list_part;
 }
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn list_part_avx2_fma<const MIN: bool>(
-    pairs: Pairs,
-    e: &[f64],
-    w: &[f64],
-    r: std::ops::Range<usize>,
-) -> Vec<f64> {
-    list_part::<MIN>(pairs, e, w, r)
-}
-
-fn part_fast<const MIN: bool>(
-    f: &[&[f64]],
-    g: &[&[f64]],
-    e: &[f64],
-    w: &[f64],
-    r: std::ops::Range<usize>,
-) -> Vec<f64> {
-    #[cfg(target_arch = "x86_64")]
-    if crate::cpu::uses_avx2_fma() {
-        // SAFETY: the processor has the features the copy is compiled for.
-        return unsafe { part_avx2_fma::<MIN>(f, g, e, w, r) };
-    }
-    part_as::<MIN>(f, g, e, w, r)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
-unsafe fn part_avx2_fma<const MIN: bool>(
-    f: &[&[f64]],
-    g: &[&[f64]],
-    e: &[f64],
-    w: &[f64],
-    r: std::ops::Range<usize>,
-) -> Vec<f64> {
-    part_as::<MIN>(f, g, e, w, r)
+crate::cpu::wide_copy! {
+    /// [`part_as`] through a copy compiled for AVX2 ([`crate::cpu::wide_copy`]).
+    fn part_fast<const MIN: bool>(
+        f: &[&[f64]],
+        g: &[&[f64]],
+        e: &[f64],
+        w: &[f64],
+        r: std::ops::Range<usize>,
+    ) -> Vec<f64> = part_as;
 }
 
 /// [`list`]'s sums over the points `r`, four nodes at a time, each in point order.
