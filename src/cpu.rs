@@ -39,7 +39,8 @@ pub fn uses_avx2_fma() -> bool {
 /// large, or a closure called from several places) runs as baseline code, which a profile shows
 /// outside `avx2_fma`: such a body gets its own `#[target_feature]` copy behind
 /// [`uses_avx2_fma`], as the master curve's evaluations have
-/// ([`crate::models::viscoelastic::master::e_master_in_place`]).
+/// ([`crate::models::viscoelastic::master::e_master_in_place`]), or through the crate's
+/// `wide_copy!` macro, as the separable cell bound's pass and node sums do.
 #[inline]
 pub fn fast<R>(f: impl FnOnce() -> R) -> R {
     #[cfg(target_arch = "x86_64")]
