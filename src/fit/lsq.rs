@@ -496,11 +496,10 @@ pub fn levenberg_marquardt_to(
         let spec = if last || !fuses {
             None
         } else {
+            // The spare is this fit's last Jacobian (the same shape) or none, which the problem
+            // then makes ([`Residuals::residuals_and_jacobian`]).
             if jac_trial.shape() != (n, n_free) {
                 jac_trial = std::mem::replace(&mut spare, DMatrix::zeros(0, 0));
-                if jac_trial.shape() != (n, n_free) {
-                    jac_trial = DMatrix::zeros(n, n_free);
-                }
             }
             let spec = p.residuals_and_jacobian(&trial, &mut f_new, free, &mut jac_trial);
             fuses = spec.is_some();
