@@ -13,6 +13,7 @@
 //! as it was, bit for bit.
 
 use super::cell::Cell;
+use wide::f64x4;
 
 /// A pass's per-point sums, as [`super::PassSums`] holds them (the first-order bound; phi,
 /// its gradient, (generalised) Hessian and the gradient terms' magnitudes).
@@ -252,19 +253,31 @@ pub(super) fn run<const MIN: bool, const FIRST: bool, const SECOND: bool>(
         }
         // Point j's nine terms sit in nine columns at index j; each column is added into four
         // lanes (point j into lane j mod 4), a vector addition per four points, the lanes held
-        // in registers over the block.
+        // in registers over the block. The columns are added side by side, four points of
+        // each in turn: nine independent additions per step (column after column, each
+        // column's additions waited on the last one's latency: a sixth of a pass), the same
+        // additions in the same order in every lane.
         let quads = m / LANES * LANES;
-        for (acc, b) in lanes.iter_mut().zip(&block).take(columns) {
-            let mut a = *acc;
-            for q in b[..quads].chunks_exact(LANES) {
-                for l in 0..LANES {
-                    a[l] += q[l];
+        if SECOND {
+            let mut acc = lanes.map(f64x4::new);
+            for q in (0..quads).step_by(LANES) {
+                for (a, b) in acc.iter_mut().zip(&block) {
+                    *a += f64x4::new([b[q], b[q + 1], b[q + 2], b[q + 3]]);
                 }
             }
-            for (l, v) in b[quads..m].iter().enumerate() {
-                a[l] += v;
+            lanes = acc.map(|a| a.to_array());
+        } else {
+            let mut a = f64x4::new(lanes[0]);
+            for q in (0..quads).step_by(LANES) {
+                let b = &block[0];
+                a += f64x4::new([b[q], b[q + 1], b[q + 2], b[q + 3]]);
             }
-            *acc = a;
+            lanes[0] = a.to_array();
+        }
+        for (acc, b) in lanes.iter_mut().zip(&block).take(columns) {
+            for (l, v) in b[quads..m].iter().enumerate() {
+                acc[l] += v;
+            }
         }
         start = end;
     }
