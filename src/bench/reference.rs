@@ -38,7 +38,8 @@ fn parse_vm(text: &str) -> std::result::Result<Vec<VmRef>, DataError> {
     t.rows
         .iter()
         .map(|row| {
-            let rule = row.fields[cr]
+            let rule = t
+                .field(row, cr)
                 .parse::<ContactEnd>()
                 .map_err(|m| t.cell_error(row, cr, m))?;
             Ok(VmRef {
@@ -81,7 +82,7 @@ pub fn series_constant(name: &str) -> Option<f64> {
     let (cn, cv) = (t.column("name")?, t.column("value")?);
     t.rows
         .iter()
-        .find(|r| &r.fields[cn] == name)
+        .find(|r| t.field(r, cn) == name)
         .and_then(|r| t.number(r, cv).ok())
 }
 

@@ -72,7 +72,7 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
     let mut accs: Vec<Acc> = Vec::new();
     let mut index: HashMap<String, usize> = HashMap::new();
     for row in &table.rows {
-        let id = row.fields[id_col].to_string();
+        let id = table.field(row, id_col).to_string();
         if id.is_empty() {
             return Err(table.cell_error(row, id_col, "empty collision id"));
         }
@@ -85,7 +85,7 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
         let d2 = table.number_where(row, d2_col, positive, "a diameter > 0 (mm)")? * 1e-3;
         let post = match phase_col {
             None => None,
-            Some(c) => match &row.fields[c] {
+            Some(c) => match table.field(row, c) {
                 "pre" => Some(false),
                 "post" => Some(true),
                 other => {
@@ -100,7 +100,7 @@ pub fn parse_tracks(table: &Table) -> Result<Vec<CollisionTrack>, DataError> {
         let mut spins = [f64::NAN; 4];
         let mut have_spins = false;
         for (k, c) in spin_cols.iter().enumerate() {
-            if let Some(c) = c.filter(|&c| !row.fields[c].is_empty()) {
+            if let Some(c) = c.filter(|&c| !table.field(row, c).is_empty()) {
                 spins[k] = table.number(row, c)?;
                 have_spins = true;
             }

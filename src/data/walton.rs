@@ -109,7 +109,7 @@ pub fn read_collisions(
                 ),
             }),
             None => Ok(0.0),
-            Some(c) if zero_ok && row.fields[c].is_empty() => Ok(0.0),
+            Some(c) if zero_ok && table.field(row, c).is_empty() => Ok(0.0),
             Some(c) => table.number(row, c),
         };
         let mut v1 = [0.0; 15];
@@ -192,7 +192,7 @@ pub fn read_collisions(
         }
         records.push(CollisionRecord {
             line: row.line,
-            id: id_col.map(|c| row.fields[c].to_string()),
+            id: id_col.map(|c| table.field(row, c).to_string()),
             pre,
             post,
         });

@@ -192,8 +192,8 @@ mod tests {
         assert_eq!(t.rows.len(), ids.len(), "{text}");
         for (i, (row, id)) in t.rows.iter().zip(ids).enumerate() {
             // The reader trims blanks around a field.
-            assert_eq!(&row.fields[0], id.trim(), "{text}");
-            assert_eq!(&row.fields[1], i.to_string());
+            assert_eq!(t.field(row, 0), id.trim(), "{text}");
+            assert_eq!(t.field(row, 1), i.to_string());
         }
     }
 
