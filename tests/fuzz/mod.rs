@@ -222,7 +222,7 @@ fn input_ids(case: &Case) -> Vec<String> {
         if let Ok(t) = restitution::data::Table::parse_bytes(name, bytes) {
             for col in ["collision", "id"] {
                 if let Some(c) = t.column(col) {
-                    ids.extend(t.rows.iter().map(|r| r.fields[c].to_string()));
+                    ids.extend(t.rows.iter().map(|r| t.field(r, c).to_string()));
                 }
             }
         }

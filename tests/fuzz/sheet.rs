@@ -72,13 +72,18 @@ pub struct Sheet {
 impl Sheet {
     pub fn parse(text: &str) -> Sheet {
         let t = Table::parse("base", text).expect("the base data are valid");
+        let rows = t
+            .rows
+            .iter()
+            .map(|r| {
+                (0..t.headers.len())
+                    .map(|c| t.field(r, c).to_string())
+                    .collect()
+            })
+            .collect();
         Sheet {
             header: t.headers,
-            rows: t
-                .rows
-                .into_iter()
-                .map(|r| r.fields.iter().map(str::to_string).collect())
-                .collect(),
+            rows,
             comments: false,
             crlf: false,
             bom: false,
