@@ -80,10 +80,12 @@ impl Suspicion {
             count: 0,
         }
     }
-    fn note(&mut self, err: DataError) {
+    /// One more row; its message is made only for the first (a file of 100 000 rows may have
+    /// thousands of them).
+    fn note(&mut self, err: impl FnOnce() -> DataError) {
         self.count += 1;
         if self.first.is_none() {
-            self.first = Some(err);
+            self.first = Some(err());
         }
     }
     fn finish(self) -> Option<DataError> {
@@ -112,9 +114,9 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
     let mut tiny = Suspicion::new();
     let mut obs = Vec::with_capacity(table.rows.len());
     let mut lines = Vec::with_capacity(table.rows.len());
-    let strict_or = |s: &mut Suspicion, err: DataError| -> Result<(), DataError> {
+    let strict_or = |s: &mut Suspicion, err: &dyn Fn() -> DataError| -> Result<(), DataError> {
         if strict {
-            let mut err = err;
+            let mut err = err();
             err.message += " (an error with --strict)";
             Err(err)
         } else {
@@ -125,21 +127,25 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
     for row in &table.rows {
         let d_mm = table.number_where(row, c_d, |x| x > 0.0, "a diameter > 0 (mm)")?;
         if d_mm < 0.1 {
-            let msg = format!(
-                "'{}' is below 0.1 mm: is the diameter in metres? (d_mm is millimetres)",
-                table.shown(row, c_d)
-            );
-            strict_or(&mut tiny, table.cell_error(row, c_d, msg))?;
+            strict_or(&mut tiny, &|| {
+                let msg = format!(
+                    "'{}' is below 0.1 mm: is the diameter in metres? (d_mm is millimetres)",
+                    table.shown(row, c_d)
+                );
+                table.cell_error(row, c_d, msg)
+            })?;
         }
         let d2_mm = match c_d2 {
             Some(c) => {
                 let d2 = table.positive_or_inf(row, c)?;
                 if d2 < 0.1 {
-                    let msg = format!(
-                        "'{}' is below 0.1 mm: is the diameter in metres? (d2_mm is millimetres)",
-                        table.shown(row, c)
-                    );
-                    strict_or(&mut tiny, table.cell_error(row, c, msg))?;
+                    strict_or(&mut tiny, &|| {
+                        let msg = format!(
+                            "'{}' is below 0.1 mm: is the diameter in metres? (d2_mm is millimetres)",
+                            table.shown(row, c)
+                        );
+                        table.cell_error(row, c, msg)
+                    })?;
                 }
                 Some(d2)
             }
@@ -148,11 +154,13 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
         let v = table.number_where(row, c_v, |x| x > 0.0, "a speed > 0 (m/s)")?;
         let e = table.number_where(row, c_e, |x| x >= 0.0, "e >= 0")?;
         if e > 1.0 {
-            let msg = format!(
-                "'{}' is above 1 (kept: possible within the errors of a measurement)",
-                table.shown(row, c_e)
-            );
-            strict_or(&mut above_one, table.cell_error(row, c_e, msg))?;
+            strict_or(&mut above_one, &|| {
+                let msg = format!(
+                    "'{}' is above 1 (kept: possible within the errors of a measurement)",
+                    table.shown(row, c_e)
+                );
+                table.cell_error(row, c_e, msg)
+            })?;
         }
         let e_err = match (c_eerr, c_verr) {
             (Some(c), _) => Some(table.number_where(
