@@ -11,7 +11,7 @@
 //! e > 1 (possible within the errors of a real measurement, so such rows are kept) and a
 //! diameter below 0.1 mm (probably metres). `strict` turns them into errors.
 
-use super::{DataError, DataFailure, Table};
+use super::{DataError, DataFailure, Row, Table};
 use crate::contact::Material;
 use crate::error::Num;
 use crate::fit::dataset::{E_ERR_MAX, E_ERR_MIN, FitData, Observation};
@@ -67,6 +67,20 @@ pub fn parse_fit_csv(
     from_table(&table, material, strict)
 }
 
+/// Rows at and above which a file's rows are converted in parts on all cores, and the rows
+/// of a part.
+const PARALLEL_ROWS: usize = 16_384;
+const PART_ROWS: usize = 4096;
+
+/// The observations of some consecutive rows, what they raised, and the error that stopped
+/// them (if one did).
+struct Part {
+    obs: Vec<Observation>,
+    tiny: Suspicion,
+    above_one: Suspicion,
+    error: Option<DataError>,
+}
+
 /// A suspicious value seen in some rows: the first one and how many.
 struct Suspicion {
     first: Option<DataError>,
@@ -86,6 +100,13 @@ impl Suspicion {
         self.count += 1;
         if self.first.is_none() {
             self.first = Some(err());
+        }
+    }
+    /// The rows of `later` (after these) too.
+    fn join(&mut self, later: Suspicion) {
+        self.count += later.count;
+        if self.first.is_none() {
+            self.first = later.first;
         }
     }
     fn finish(self) -> Option<DataError> {
@@ -110,10 +131,6 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
         (None, Some(_)) => ErrorSource::VErr,
         (None, None) => ErrorSource::None,
     };
-    let mut above_one = Suspicion::new();
-    let mut tiny = Suspicion::new();
-    let mut obs = Vec::with_capacity(table.rows.len());
-    let mut lines = Vec::with_capacity(table.rows.len());
     let strict_or = |s: &mut Suspicion, err: &dyn Fn() -> DataError| -> Result<(), DataError> {
         if strict {
             let mut err = err();
@@ -124,10 +141,10 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
             Ok(())
         }
     };
-    for row in &table.rows {
+    let observe = |row: &Row, tiny: &mut Suspicion, above_one: &mut Suspicion| {
         let d_mm = table.number_where(row, c_d, |x| x > 0.0, "a diameter > 0 (mm)")?;
         if d_mm < 0.1 {
-            strict_or(&mut tiny, &|| {
+            strict_or(tiny, &|| {
                 let msg = format!(
                     "'{}' is below 0.1 mm: is the diameter in metres? (d_mm is millimetres)",
                     table.shown(row, c_d)
@@ -139,7 +156,7 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
             Some(c) => {
                 let d2 = table.positive_or_inf(row, c)?;
                 if d2 < 0.1 {
-                    strict_or(&mut tiny, &|| {
+                    strict_or(tiny, &|| {
                         let msg = format!(
                             "'{}' is below 0.1 mm: is the diameter in metres? (d2_mm is millimetres)",
                             table.shown(row, c)
@@ -154,7 +171,7 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
         let v = table.number_where(row, c_v, |x| x > 0.0, "a speed > 0 (m/s)")?;
         let e = table.number_where(row, c_e, |x| x >= 0.0, "e >= 0")?;
         if e > 1.0 {
-            strict_or(&mut above_one, &|| {
+            strict_or(above_one, &|| {
                 let msg = format!(
                     "'{}' is above 1 (kept: possible within the errors of a measurement)",
                     table.shown(row, c_e)
@@ -195,15 +212,52 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
             }
             (None, None) => None,
         };
-        obs.push(Observation {
+        Ok(Observation {
             d_mm,
             d2_mm,
             v_n_m_s: v,
             e,
             e_err,
-        });
-        lines.push(row.line);
+        })
+    };
+    // Rows in order, up to the first error (a part of the file, or all of it).
+    let part = |rows: &[Row]| {
+        let mut p = Part {
+            obs: Vec::with_capacity(rows.len()),
+            tiny: Suspicion::new(),
+            above_one: Suspicion::new(),
+            error: None,
+        };
+        for row in rows {
+            match observe(row, &mut p.tiny, &mut p.above_one) {
+                Ok(o) => p.obs.push(o),
+                Err(e) => {
+                    p.error = Some(e);
+                    break;
+                }
+            }
+        }
+        p
+    };
+    // Large files in parts on all cores (the fit's start is serial), joined in row order: the
+    // first error in the file, each suspicion's first row and count, as row by row.
+    let parts = if table.rows.len() >= PARALLEL_ROWS {
+        use rayon::prelude::*;
+        table.rows.par_chunks(PART_ROWS).map(part).collect()
+    } else {
+        vec![part(&table.rows)]
+    };
+    let (mut tiny, mut above_one) = (Suspicion::new(), Suspicion::new());
+    let mut obs = Vec::with_capacity(table.rows.len());
+    for p in parts {
+        obs.extend(p.obs);
+        tiny.join(p.tiny);
+        above_one.join(p.above_one);
+        if let Some(e) = p.error {
+            return Err(e);
+        }
     }
+    let lines = table.rows.iter().map(|r| r.line).collect();
     let data = FitData::new(material, obs).map_err(|e| DataError {
         path: table.path.clone(),
         line: None,
@@ -230,6 +284,49 @@ mod tests {
 
     fn nylon() -> Material {
         Material::preset("nylon").unwrap()
+    }
+
+    /// A large file is converted in parts on all cores, with the answers of a row by row
+    /// pass: every row in order, the first error (not one from a later part), each suspicion's
+    /// first row and count across the parts, and under --strict the first suspicious row.
+    #[test]
+    fn large_files_read_as_row_by_row() {
+        let n = PARALLEL_ROWS + 2 * PART_ROWS + 5;
+        let text = |bad: &[usize]| {
+            let mut t = String::from("d_mm,v_n_m_s,e\n");
+            for i in 0..n {
+                let e = match i {
+                    _ if bad.contains(&i) => "x".to_string(),
+                    100 | 5000 | 19_000 => "1.25".to_string(),
+                    _ => format!("0.{}", 5 + i % 4),
+                };
+                t += &format!("10,{},{e}\n", 1.0 + i as f64 * 1e-4);
+            }
+            t
+        };
+        // Line of row i: the header is line 1.
+        let line = |i: usize| i + 2;
+        let inp = parse_fit_csv("f.csv", &text(&[]), nylon(), false).unwrap();
+        assert_eq!(inp.data.len(), n);
+        assert_eq!(inp.lines, (0..n).map(line).collect::<Vec<_>>());
+        assert!((0..n).all(|i| inp.data.obs[i].v_n_m_s == 1.0 + i as f64 * 1e-4));
+        assert_eq!(inp.warnings.len(), 1);
+        assert_eq!(
+            inp.warnings[0].to_string(),
+            format!(
+                "f.csv:{}: column 'e': '1.25' is above 1 (kept: possible within the errors of \
+                 a measurement) (and 2 more rows like it)",
+                line(100)
+            )
+        );
+        // Errors in two parts: the earlier one.
+        let bad = [PARALLEL_ROWS + PART_ROWS + 1, PARALLEL_ROWS + 3];
+        let e = parse_fit_csv("f.csv", &text(&bad), nylon(), false).unwrap_err();
+        assert_eq!(e.line, Some(line(PARALLEL_ROWS + 3)), "{e}");
+        // --strict: the first row above 1, before either error.
+        let e = parse_fit_csv("f.csv", &text(&bad), nylon(), true).unwrap_err();
+        assert_eq!(e.line, Some(line(100)), "{e}");
+        assert!(e.to_string().ends_with("(an error with --strict)"), "{e}");
     }
 
     #[test]

@@ -296,28 +296,22 @@ impl fmt::Debug for RowMemo {
 
 impl<'a> Evaluator<'a> {
     pub fn new(data: &'a FitData, rule: ContactEnd, method: VmMethod) -> Self {
-        let pts = data.obs.iter().zip(&data.contacts);
+        let (obs, contacts) = (&data.obs, &data.contacts);
+        // Each a value per point (on all cores for large data: the fit's start is serial).
+        let per_point = |f: &(dyn Fn(usize) -> f64 + Sync)| {
+            let mut v = vec![0.0; obs.len()];
+            sums::fill(&mut v, f);
+            v
+        };
         let mut ev = Evaluator {
             data,
             rule,
             method,
-            kappa_per_eta: pts.clone().map(|(o, c)| c.kappa(1.0, o.v_n_m_s)).collect(),
-            v_yield_per_pa: data
-                .contacts
-                .iter()
-                .map(|c| c.yield_velocity_m_s(1.0))
-                .collect(),
-            v_n_m_s: data.obs.iter().map(|o| o.v_n_m_s).collect(),
-            powerlaw_ln_d: data
-                .contacts
-                .iter()
-                .map(|c| (powerlaw_d_mm(c) / POWERLAW_D_REF_MM).ln())
-                .collect(),
-            powerlaw_ln_v: data
-                .obs
-                .iter()
-                .map(|o| (o.v_n_m_s / POWERLAW_V_REF_M_S).ln())
-                .collect(),
+            kappa_per_eta: per_point(&|i| contacts[i].kappa(1.0, obs[i].v_n_m_s)),
+            v_yield_per_pa: per_point(&|i| contacts[i].yield_velocity_m_s(1.0)),
+            v_n_m_s: obs.iter().map(|o| o.v_n_m_s).collect(),
+            powerlaw_ln_d: per_point(&|i| (powerlaw_d_mm(&contacts[i]) / POWERLAW_D_REF_MM).ln()),
+            powerlaw_ln_v: per_point(&|i| (obs[i].v_n_m_s / POWERLAW_V_REF_M_S).ln()),
             kappa_order: Vec::new(),
             kappa_per_eta_in_order: Vec::new(),
             rows: RowMemo::default(),
