@@ -141,28 +141,26 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
             Ok(())
         }
     };
+    // A diameter below 0.1 mm in column `c` (named `key`).
+    let in_metres = |tiny: &mut Suspicion, row: &Row, c: usize, key: &str| {
+        strict_or(tiny, &|| {
+            let msg = format!(
+                "'{}' is below 0.1 mm: is the diameter in metres? ({key} is millimetres)",
+                table.shown(row, c)
+            );
+            table.cell_error(row, c, msg)
+        })
+    };
     let observe = |row: &Row, tiny: &mut Suspicion, above_one: &mut Suspicion| {
         let d_mm = table.number_where(row, c_d, |x| x > 0.0, "a diameter > 0 (mm)")?;
         if d_mm < 0.1 {
-            strict_or(tiny, &|| {
-                let msg = format!(
-                    "'{}' is below 0.1 mm: is the diameter in metres? (d_mm is millimetres)",
-                    table.shown(row, c_d)
-                );
-                table.cell_error(row, c_d, msg)
-            })?;
+            in_metres(tiny, row, c_d, "d_mm")?;
         }
         let d2_mm = match c_d2 {
             Some(c) => {
                 let d2 = table.positive_or_inf(row, c)?;
                 if d2 < 0.1 {
-                    strict_or(tiny, &|| {
-                        let msg = format!(
-                            "'{}' is below 0.1 mm: is the diameter in metres? (d2_mm is millimetres)",
-                            table.shown(row, c)
-                        );
-                        table.cell_error(row, c, msg)
-                    })?;
+                    in_metres(tiny, row, c, "d2_mm")?;
                 }
                 Some(d2)
             }
