@@ -241,22 +241,23 @@ pub struct Merged {
     pub first_row: Vec<usize>,
 }
 
+/// What makes two rows repeats: the same pair geometry and speed, to the bit (a wall, no second
+/// size, differs from every second size).
+fn repeat_key(o: &Observation) -> [u64; 4] {
+    [
+        o.d_mm.to_bits(),
+        u64::from(o.d2_mm.is_some()),
+        o.d2_mm.map_or(0, f64::to_bits),
+        o.v_n_m_s.to_bits(),
+    ]
+}
+
 /// Whether no two rows share a pair geometry and a speed (to the bit), from the rows' keys
 /// sorted: large files of measured speeds usually have no repeats, and a sort (on all cores for
 /// large data) finds that in a few milliseconds on 100 000 rows, where filling the merge's hash
 /// map (5 MB, a cache miss per row) took 10 to 35 on the fit's serial start.
 fn all_distinct(obs: &[Observation]) -> bool {
-    let mut keys: Vec<[u64; 4]> = obs
-        .iter()
-        .map(|o| {
-            [
-                o.d_mm.to_bits(),
-                u64::from(o.d2_mm.is_some()),
-                o.d2_mm.map_or(0, f64::to_bits),
-                o.v_n_m_s.to_bits(),
-            ]
-        })
-        .collect();
+    let mut keys: Vec<[u64; 4]> = obs.iter().map(repeat_key).collect();
     if super::sums::is_large(keys.len()) {
         use rayon::prelude::*;
         keys.par_sort_unstable();
@@ -277,13 +278,6 @@ impl FitData {
     /// products, profiles and differences of chi2. Repeated launches at one nominal speed make
     /// such data; so do files of repeated rows, which would otherwise cost the fit their count.
     pub fn merge_repeats(&self) -> Option<Merged> {
-        let key = |o: &Observation| {
-            (
-                o.d_mm.to_bits(),
-                o.d2_mm.map(f64::to_bits),
-                o.v_n_m_s.to_bits(),
-            )
-        };
         if all_distinct(&self.obs) {
             return None;
         }
@@ -294,7 +288,7 @@ impl FitData {
         let mut first_row = Vec::new();
         for (i, o) in self.obs.iter().enumerate() {
             let next = first_row.len();
-            let p = *index.entry(key(o)).or_insert(next);
+            let p = *index.entry(repeat_key(o)).or_insert(next);
             if p == next {
                 first_row.push(i);
             }
