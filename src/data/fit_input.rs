@@ -15,6 +15,7 @@ use super::{DataError, DataFailure, Row, Table};
 use crate::contact::Material;
 use crate::error::Num;
 use crate::fit::dataset::{E_ERR_MAX, E_ERR_MIN, FitData, Observation};
+use crate::fit::sums;
 use std::path::Path;
 
 /// Where the errors of e came from.
@@ -66,11 +67,6 @@ pub fn parse_fit_csv(
     let table = Table::parse(name, text)?;
     from_table(&table, material, strict)
 }
-
-/// Rows at and above which a file's rows are converted in parts on all cores, and the rows
-/// of a part.
-const PARALLEL_ROWS: usize = 16_384;
-const PART_ROWS: usize = 4096;
 
 /// The observations of some consecutive rows, what they raised, and the error that stopped
 /// them (if one did).
@@ -239,9 +235,9 @@ fn from_table(table: &Table, material: Material, strict: bool) -> Result<FitInpu
     };
     // Large files in parts on all cores (the fit's start is serial), joined in row order: the
     // first error in the file, each suspicion's first row and count, as row by row.
-    let parts = if table.rows.len() >= PARALLEL_ROWS {
+    let parts = if sums::is_large(table.rows.len()) {
         use rayon::prelude::*;
-        table.rows.par_chunks(PART_ROWS).map(part).collect()
+        table.rows.par_chunks(sums::CHUNK).map(part).collect()
     } else {
         vec![part(&table.rows)]
     };
@@ -289,7 +285,7 @@ mod tests {
     /// first row and count across the parts, and under --strict the first suspicious row.
     #[test]
     fn large_files_read_as_row_by_row() {
-        let n = PARALLEL_ROWS + 2 * PART_ROWS + 5;
+        let n = sums::PARALLEL_MIN_POINTS + 2 * sums::CHUNK + 5;
         let text = |bad: &[usize]| {
             let mut t = String::from("d_mm,v_n_m_s,e\n");
             for i in 0..n {
@@ -318,9 +314,10 @@ mod tests {
             )
         );
         // Errors in two parts: the earlier one.
-        let bad = [PARALLEL_ROWS + PART_ROWS + 1, PARALLEL_ROWS + 3];
+        let first = sums::PARALLEL_MIN_POINTS + 3;
+        let bad = [first + sums::CHUNK, first];
         let e = parse_fit_csv("f.csv", &text(&bad), nylon(), false).unwrap_err();
-        assert_eq!(e.line, Some(line(PARALLEL_ROWS + 3)), "{e}");
+        assert_eq!(e.line, Some(line(first)), "{e}");
         // --strict: the first row above 1, before either error.
         let e = parse_fit_csv("f.csv", &text(&bad), nylon(), true).unwrap_err();
         assert_eq!(e.line, Some(line(100)), "{e}");
