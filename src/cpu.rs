@@ -57,30 +57,35 @@ unsafe fn avx2_fma<R>(f: impl FnOnce() -> R) -> R {
     f()
 }
 
-/// Defines `fn $name<consts>(args) -> R` that calls `$body::<consts>(args)` (an
-/// `#[inline(always)]` function, by its path) through a copy of its own compiled for AVX2 and FMA
-/// where [`uses_avx2_fma`], else as it is. Why: a closure handed to [`fast`] that the inliner
-/// leaves out of its wrapper runs as baseline code, and which ones it leaves out moves with
-/// unrelated changes (the separable cell bound's pass and node sums each ran so, a tenth of a
-/// fit); a `#[target_feature]` function of its own always has the features. The same
-/// operations either way, so the same bits (see the module doc).
+/// Defines `fn $inner<consts>(args) -> R { body }` (`#[inline(always)]`) and `fn $name` with
+/// the same signature, which calls it through a copy of its own compiled for AVX2 and FMA where
+/// [`uses_avx2_fma`], else as it is: one signature for both. Why: a closure handed to [`fast`]
+/// that the inliner leaves out of its wrapper runs as baseline code, and which ones it leaves
+/// out moves with unrelated changes (the separable cell bound's pass and node sums each ran so,
+/// a tenth of a fit); a `#[target_feature]` function of its own always has the features. The
+/// same operations either way, so the same bits (see the module doc).
 macro_rules! wide_copy {
-    ($(#[$m:meta])* fn $name:ident<$(const $c:ident: $ct:ty),*>($($a:ident: $t:ty),* $(,)?) -> $r:ty
-        = $($body:ident)::+;) => {
+    ($(#[$m:meta])* fn $name:ident;
+     $(#[$im:meta])* fn $inner:ident<$(const $c:ident: $ct:ty),*>($($a:ident: $t:ty),* $(,)?)
+        -> $r:ty $body:block) => {
+        $(#[$im])*
+        #[inline(always)]
+        fn $inner<$(const $c: $ct),*>($($a: $t),*) -> $r $body
+
         $(#[$m])*
         fn $name<$(const $c: $ct),*>($($a: $t),*) -> $r {
             #[cfg(target_arch = "x86_64")]
             {
                 #[target_feature(enable = "avx2,fma")]
                 unsafe fn copy<$(const $c: $ct),*>($($a: $t),*) -> $r {
-                    $($body)::+::<$($c),*>($($a),*)
+                    $inner::<$($c),*>($($a),*)
                 }
                 if $crate::cpu::uses_avx2_fma() {
                     // SAFETY: the processor has the features the copy is compiled for.
                     return unsafe { copy::<$($c),*>($($a),*) };
                 }
             }
-            $($body)::+::<$($c),*>($($a),*)
+            $inner::<$($c),*>($($a),*)
         }
     };
 }

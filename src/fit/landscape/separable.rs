@@ -219,7 +219,7 @@ impl<'a> Separable<'a> {
             let mut v = [0.0; 13];
             for r in &self.sample.chunks {
                 let mut p = crate::cpu::fast(|| {
-                    Self::part_as::<MIN, FIRST, SECOND>(cell, e, w, x, r.clone(), false)
+                    part_as::<MIN, FIRST, SECOND>(cell, e, w, x, r.clone(), false)
                 });
                 if with_loose {
                     let l =
@@ -245,39 +245,6 @@ impl<'a> Separable<'a> {
             loose1: [v[9], v[10]],
             loose2: [v[11], v[12]],
         }
-    }
-
-    /// A pass's sums over `points` (consecutive, summed in order), in `pass_as`'s order; inlined
-    /// into each caller, so that the wide registers' copy of the loop is the one that runs.
-    #[inline(always)]
-    fn part_as<const MIN: bool, const FIRST: bool, const SECOND: bool>(
-        cell: &Cell,
-        e: &[f64],
-        w: &[f64],
-        x: [f64; 2],
-        points: std::ops::Range<usize>,
-        with_loose: bool,
-    ) -> [f64; 13] {
-        let mut s = PassSums::default();
-        if with_loose {
-            for i in points.clone() {
-                let l1 = loose_first::<MIN>(cell, i, w[i], e[i]);
-                s.loose1[0] += l1[0];
-                s.loose1[1] += l1[1];
-                if SECOND {
-                    let l2 = cell.loose_second(i, w[i], e[i]);
-                    s.loose2[0] += l2[0];
-                    s.loose2[1] += l2[1];
-                }
-            }
-        }
-        let t = kernel::run::<MIN, FIRST, SECOND>(cell, e, w, x, points);
-        let [g0, g1] = t.g;
-        let [h0, h1, h2] = t.h;
-        let [a0, a1] = t.g_abs;
-        let [o0, o1] = s.loose1;
-        let [n0, n1] = s.loose2;
-        [t.first, t.phi, g0, g1, h0, h1, h2, a0, a1, o0, o1, n0, n1]
     }
 
     /// The loosenesses' sums over `points` (consecutive, in order), as `part_as` adds them:
@@ -506,17 +473,41 @@ impl Separable<'_> {
 }
 
 crate::cpu::wide_copy! {
-    /// A full pass's sums over `points` ([`Separable::part_as`]) through a copy compiled for
+    /// A full pass's sums over `points` ([`part_as`]) through a copy compiled for
     /// AVX2 ([`crate::cpu::wide_copy`]: its closure inside `cpu::fast` had been left out of the
     /// wrapper, 3% of `--model all` on 100 000 points of distinct sizes).
-    fn part_fast<const MIN: bool, const FIRST: bool, const SECOND: bool>(
+    fn part_fast;
+    /// A pass's sums over `points` (consecutive, summed in order), in `pass_as`'s order; inlined
+    /// into each caller, so that the wide registers' copy of the loop is the one that runs.
+    fn part_as<const MIN: bool, const FIRST: bool, const SECOND: bool>(
         cell: &Cell,
         e: &[f64],
         w: &[f64],
         x: [f64; 2],
         points: std::ops::Range<usize>,
         with_loose: bool,
-    ) -> [f64; 13] = Separable::part_as;
+    ) -> [f64; 13] {
+        let mut s = PassSums::default();
+        if with_loose {
+            for i in points.clone() {
+                let l1 = loose_first::<MIN>(cell, i, w[i], e[i]);
+                s.loose1[0] += l1[0];
+                s.loose1[1] += l1[1];
+                if SECOND {
+                    let l2 = cell.loose_second(i, w[i], e[i]);
+                    s.loose2[0] += l2[0];
+                    s.loose2[1] += l2[1];
+                }
+            }
+        }
+        let t = kernel::run::<MIN, FIRST, SECOND>(cell, e, w, x, points);
+        let [g0, g1] = t.g;
+        let [h0, h1, h2] = t.h;
+        let [a0, a1] = t.g_abs;
+        let [o0, o1] = s.loose1;
+        let [n0, n1] = s.loose2;
+        [t.first, t.phi, g0, g1, h0, h1, h2, a0, a1, o0, o1, n0, n1]
+    }
 }
 
 /// Whether any value is NaN: blocks without an early exit (a loop the compiler runs several
