@@ -12,6 +12,8 @@ struct TwoWells {
     loose: bool,
     /// Nodes evaluated so far.
     evaluated: std::cell::Cell<usize>,
+    /// The cells bounded so far: lower and upper corners.
+    bounded: std::cell::RefCell<Vec<([f64; 2], [f64; 2])>>,
 }
 fn g(x: f64) -> f64 {
     ((x + 1.0).powi(2) + 0.5).min((x - 2.0).powi(2))
@@ -32,6 +34,7 @@ impl TwoWells {
             y: vec![],
             loose,
             evaluated: Default::default(),
+            bounded: Default::default(),
         }
     }
 }
@@ -56,6 +59,10 @@ impl Landscape for TwoWells {
         g(self.x[r[0]]) + (self.y[r[1]] - 0.3).powi(2)
     }
     fn bound(&self, lo: [usize; 2], hi: [usize; 2], _target: f64) -> Bound {
+        self.bounded.borrow_mut().push((
+            [self.x[lo[0]], self.y[lo[1]]],
+            [self.x[hi[0]], self.y[hi[1]]],
+        ));
         // g's minima and the kink where its two branches meet (x = 1/6, where the lower
         // envelope has a local maximum) are the only interior extremes.
         let gx = lowest(g, self.x[lo[0]], self.x[hi[0]], &[-1.0, 2.0]);
@@ -555,4 +562,54 @@ fn a_narrow_cell_across_the_cut_is_bounded_over_its_part_beyond_before_any_split
     for c in across {
         assert!(c.t1[1] - c.t0[1] >= 0.5 - 1e-12, "{c:?}");
     }
+}
+
+/// [`Bnb::make_cell`]: beyond a cut at x = 1.7 (x <= 1.7 searched, its lowest point g(1.7) =
+/// 0.09 above the target 0.06), the cells across x = 1.7 hold nodes at x = 2 below the target
+/// (g(2) = 0 plus (y - 0.3)^2 <= 0.09): such a cell wider than the cut's width is halved on x
+/// without a bound, and a cell wholly beyond the cut is dropped without one, so fewer cells are
+/// bounded than made (each was before). The search is certified clear all the same.
+#[test]
+fn cells_across_the_cut_with_a_corner_below_the_target_are_split_unbounded() {
+    let (target, tau) = (0.06, 1e-4);
+    let cut = Cut {
+        axis: 0,
+        at: 1.7,
+        dir: -1.0,
+        width: 0.01,
+    };
+    let mut b = sparse_two_wells(false);
+    b.set_cut(cut);
+    b.start_on(&grid_cells(0..10), target - tau);
+    b.refine(target, &|_| tau, &|u| u);
+    let c = b.certificate(target);
+    assert!(
+        c.lowest >= target - tau && c.reasons.is_empty() && c.fine_cells == 0,
+        "{c:?}"
+    );
+    let (_, t, v) = b.best_node().unwrap();
+    assert!(v >= target && t[0] <= 1.7, "{t:?} {v}");
+    let f = |x: f64, y: f64| g(x) + (y - 0.3f64).powi(2);
+    let bounded = b.land.bounded.borrow();
+    for &(lo, hi) in bounded.iter() {
+        assert!(
+            lo[0] < 1.7,
+            "a cell wholly beyond the cut was bounded: {lo:?} {hi:?}"
+        );
+        let corner = [lo[0], hi[0]]
+            .iter()
+            .flat_map(|&x| [lo[1], hi[1]].map(|y| f(x, y)))
+            .fold(f64::INFINITY, f64::min);
+        let wide_across = lo[0] < 1.7 && 1.7 < hi[0] && hi[0] - lo[0] > cut.width;
+        assert!(
+            !(wide_across && corner < target - tau),
+            "a cell across the cut with a corner at {corner} was bounded: {lo:?} {hi:?}"
+        );
+    }
+    assert!(
+        (bounded.len() as u64) < b.cells,
+        "{} bounds for {} cells",
+        bounded.len(),
+        b.cells
+    );
 }
