@@ -446,6 +446,11 @@ impl<L: Landscape> Bnb<L> {
         }
     }
 
+    /// The rows of the node at dyadic position `p` (each axis's made if new).
+    fn rows_at(&mut self, p: [u64; 2]) -> [usize; 2] {
+        [self.row(0, p[0]), self.row(1, p[1])]
+    }
+
     fn row(&mut self, k: usize, p: u64) -> usize {
         if let Some(&r) = self.axes[k].row_of.get(&p) {
             return r;
@@ -477,7 +482,7 @@ impl<L: Landscape> Bnb<L> {
     }
 
     fn node_at(&mut self, p: [u64; 2]) -> (f64, [usize; 2]) {
-        let r = [self.row(0, p[0]), self.row(1, p[1])];
+        let r = self.rows_at(p);
         if let Some(&v) = self.nodes.get(&r) {
             return (v, r);
         }
@@ -500,7 +505,7 @@ impl<L: Landscape> Bnb<L> {
         // once (fuzz: 41 931 cells, whose corners' search of the list took 5 s of CPU).
         let mut seen: HashSet<[usize; 2]> = HashSet::new();
         for &p in ps {
-            let r = [self.row(0, p[0]), self.row(1, p[1])];
+            let r = self.rows_at(p);
             if !self.nodes.contains_key(&r) && seen.insert(r) {
                 new.push((p, r));
             }
@@ -594,8 +599,7 @@ impl<L: Landscape> Bnb<L> {
                 lowest = v;
             }
         }
-        let lo = [self.row(0, p0[0]), self.row(1, p0[1])];
-        let hi = [self.row(0, p1[0]), self.row(1, p1[1])];
+        let (lo, hi) = (self.rows_at(p0), self.rows_at(p1));
         let ok = lo
             .iter()
             .chain(&hi)
@@ -627,8 +631,7 @@ impl<L: Landscape> Bnb<L> {
 
     /// A deferred cell's bound ([`Bnb::make_cell`]), against the current target.
     fn bound_deferred(&mut self, c: &mut Cell) {
-        let lo = [self.row(0, c.p0[0]), self.row(1, c.p0[1])];
-        let hi = [self.row(0, c.p1[0]), self.row(1, c.p1[1])];
+        let (lo, hi) = (self.rows_at(c.p0), self.rows_at(c.p1));
         c.bound = self.land.bound(lo, hi, self.target);
         c.deferred = false;
         if c.bound.lb.is_nan() {
@@ -850,8 +853,7 @@ impl<L: Landscape> Bnb<L> {
             return None;
         }
         let cut_row = self.cut_row(k)?;
-        let mut lo = [self.row(0, c.p0[0]), self.row(1, c.p0[1])];
-        let mut hi = [self.row(0, c.p1[0]), self.row(1, c.p1[1])];
+        let (mut lo, mut hi) = (self.rows_at(c.p0), self.rows_at(c.p1));
         if k.dir > 0.0 {
             lo[k.axis] = cut_row;
         } else {
