@@ -723,7 +723,7 @@ impl<L: Landscape> Bnb<L> {
         for c in pending {
             self.push(c, u_of(self), tau_of, keep_of);
         }
-        while let Some(ByBound(cell)) = self.heap.pop() {
+        while let Some(ByBound(mut cell)) = self.heap.pop() {
             let u = u_of(self);
             let tau = tau_of(u);
             self.target = u - tau;
@@ -731,7 +731,6 @@ impl<L: Landscape> Bnb<L> {
                 self.done.push(cell);
                 continue;
             }
-            let mut cell = cell;
             if self.cells >= self.limits.max_cells || self.rows_total() >= self.limits.max_rows {
                 if cell.deferred {
                     self.bound_deferred(&mut cell);

@@ -81,7 +81,25 @@ pub fn fit(data: &FitData, kind: ModelKind, options: &FitOptions) -> Result<FitR
     let merged = data.merge_repeats();
     let points = merged.as_ref().map_or(data, |m| &m.data);
     let ev = Evaluator::new(points, options.rule, options.vm_method);
-    fit_points(data, merged.as_ref(), &ev, kind, options)
+    fit_alone(data, merged.as_ref(), &ev, kind, options)
+}
+
+/// [`fit_points`] for one model alone: large data on the thread pool, as a task of its own.
+/// Called from a thread outside the pool, each parallel sum would be handed to a worker and
+/// waited for (a sleep and a wake of this thread per sum: a tenth of the power law's CPU on
+/// 100 000 points of distinct sizes, in the scheduler); small data never wake the pool.
+fn fit_alone(
+    data: &FitData,
+    merged: Option<&Merged>,
+    ev: &Evaluator,
+    kind: ModelKind,
+    options: &FitOptions,
+) -> Result<FitResult> {
+    if sums::is_large(ev.len()) {
+        rayon::scope(|_| fit_points(data, merged, ev, kind, options))
+    } else {
+        fit_points(data, merged, ev, kind, options)
+    }
 }
 
 /// Fits one model to the data through `ev`, the evaluator of its points (the rows with repeats
@@ -359,15 +377,7 @@ pub fn fit_all(data: &FitData, kinds: &[ModelKind], options: &FitOptions) -> Res
     // a fifth more wall time on two cores). Small data never wake the pool (its idle workers'
     // spinning cost more than the fits' threads).
     let fits = if let [k] = kinds[..] {
-        if sums::is_large(points.len()) {
-            // On the pool, as a task of its own: each parallel sum called from this thread, not
-            // one of the pool's, is handed over to a worker and waited for (a sleep and a wake
-            // of this thread per sum: a tenth of the CPU of the power law alone on 100 000
-            // points of distinct sizes, in the scheduler).
-            vec![rayon::scope(|_| fit_points(data, merged, ev, k, options))?]
-        } else {
-            vec![fit_points(data, merged, ev, k, options)?]
-        }
+        vec![fit_alone(data, merged, ev, k, options)?]
     } else if sums::is_large(points.len()) {
         // Every fit's outcome first, then the first error in the models' order (rayon's own
         // collect into a Result returns whichever error it meets first: not reproducible).
