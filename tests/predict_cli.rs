@@ -178,6 +178,20 @@ fn bad_input_is_one_line_and_non_zero() {
     // The message names the offending value.
     let o = run(&["predict", "--model", "vm", "--kappa", "-1"]);
     assert!(stderr(&o).contains("-1"));
+    // A tolerance tighter than a double can meet names the tolerance (it made the integrator
+    // fail with an error that named the speed: `--v-m-s 3: dop853 integration failed ...`).
+    for tol in ["1e-25", "1e-200"] {
+        let args = format!(
+            "predict --model vm --material nylon --d-mm 10 --eta 200 --v-m-s 3 --method dop853 \
+             --tol {tol}"
+        );
+        let o = run(&args.split_whitespace().collect::<Vec<_>>());
+        assert!(!o.status.success());
+        assert_eq!(
+            stderr(&o),
+            format!("restitution: error: --tol {tol}: expected a number in [1e-15, 1)\n")
+        );
+    }
 }
 
 #[test]

@@ -449,6 +449,48 @@ proptest! {
     }
 }
 
+/// `predict --tol` and Python's `tol` accept OdeSettings::TOL_MIN at the tightest: both adaptive
+/// integrators meet it with the settings a caller gets (200 000 steps per phase), against the
+/// mpmath reference (kappa <= 10: Dopri5's steps run out beyond, at any tolerance near this one).
+/// Bars: Dop853's global error at 1e-15 is a few 1e-15 (REFERENCE's test: below 2e-14); Dopri5's
+/// is about a hundred times its tolerance (1e-11 at 1e-13, above): 1e-12 holds both with room.
+/// A tighter tolerance is refused: Dop853 then failed on the collision (out of steps at 1e-25,
+/// a step size underflow at 1e-200), an error that named the speed instead of the tolerance.
+#[test]
+fn the_tightest_tolerance_accepted_is_met_and_a_tighter_one_refused() {
+    for integrator in [Integrator::Dop853, Integrator::Dopri5] {
+        let s = OdeSettings::with_integrator(integrator, OdeSettings::TOL_MIN);
+        for r in reference().iter().filter(|r| r.kappa <= 10.0) {
+            let got = restitution_ode(r.kappa, r.rule, &s).unwrap();
+            assert!(
+                (got.e - r.e).abs() < 1e-12,
+                "{integrator:?} {} {}: {} vs {}",
+                r.rule,
+                r.kappa,
+                got.e,
+                r.e
+            );
+        }
+    }
+    assert_eq!(OdeSettings::check_tol(OdeSettings::TOL_MIN), Ok(()));
+    assert_eq!(OdeSettings::check_tol(0.5), Ok(()));
+    for bad in [
+        OdeSettings::TOL_MIN * (1.0 - f64::EPSILON),
+        1e-25,
+        0.0,
+        -1e-3,
+        1.0,
+        f64::NAN,
+        f64::INFINITY,
+    ] {
+        assert_eq!(
+            OdeSettings::check_tol(bad),
+            Err("expected a number in [1e-15, 1)".to_string()),
+            "{bad}"
+        );
+    }
+}
+
 #[test]
 fn coarse_settings_fail_as_errors_not_wrong_numbers() {
     // The bench's probe found coarse fixed-step RK4 at kappa 8-28 (overlap rule) returning

@@ -47,7 +47,8 @@ def e_of_kappa(
         The master-curve table (about 20 ns per value, error below 1e-14; the default ODE
         above kappa = 100) or an ODE integration at tolerance `tol` for every value.
     tol : float
-        Tolerance of the ODE methods (rtol = atol).
+        Tolerance of the ODE methods (rtol = atol), in [1e-15, 1): a double cannot meet a
+        tighter one.
 
     Raises
     ------

@@ -27,11 +27,8 @@ pub(crate) fn contact_end(s: &str) -> Outcome<ContactEnd> {
 /// The evaluation method of vm and the ODE settings of the columns that need the trajectory,
 /// as `predict --method M --tol T` chooses them.
 fn method(name: &str, tol: f64) -> Outcome<(VmMethod, OdeSettings)> {
-    if !(tol.is_finite() && tol > 0.0 && tol < 1.0) {
-        return Err(Failure::Input(format!(
-            "tol = {}: expected a number in (0, 1)",
-            fmt_num(tol)
-        )));
+    if let Err(why) = OdeSettings::check_tol(tol) {
+        return Err(Failure::Input(format!("tol = {}: {why}", fmt_num(tol))));
     }
     let ode = match name {
         "master" => return Ok((VmMethod::Master, OdeSettings::DEFAULT)),

@@ -76,7 +76,8 @@ pub struct Args {
     /// How vm evaluates e: the master curve (table and large-kappa laws, every kappa) or an ODE integrator
     #[arg(long, value_enum, default_value = "master")]
     method: MethodArg,
-    /// Tolerance of the ODE integrators (rtol = atol)
+    /// Tolerance of the ODE integrators (rtol = atol), in [1e-15, 1): a double cannot meet a
+    /// tighter one
     #[arg(long, value_name = "T", default_value_t = OdeSettings::DEFAULT.rtol)]
     tol: f64,
     #[arg(long, value_enum, default_value = "table")]
@@ -98,12 +99,8 @@ fn flagged(f: predict::Failure) -> String {
 }
 
 pub fn run(args: Args) -> CliResult {
-    if !(args.tol.is_finite() && args.tol > 0.0 && args.tol < 1.0) {
-        return Err(format!(
-            "--tol {}: expected a number in (0, 1)",
-            fmt_num(args.tol)
-        ));
-    }
+    OdeSettings::check_tol(args.tol)
+        .map_err(|why| format!("--tol {}: {why}", fmt_num(args.tol)))?;
     let ode = match args.method {
         MethodArg::Dop853 => OdeSettings::with_integrator(Integrator::Dop853, args.tol),
         MethodArg::Dopri5 => OdeSettings::with_integrator(Integrator::Dopri5, args.tol),
