@@ -734,3 +734,32 @@ fn the_default_scene_is_the_measured_one() {
         "field 'data.wall' is \"yes\", expected true or false",
     );
 }
+
+/// A negative number is a flag's value: Walton's beta_0 lies in [-1, 1], and `--beta0 -0.5`
+/// was read as the short flags `-0` and `.5` ("unexpected argument '-0' found").
+#[test]
+fn negative_values_are_values() {
+    let dir = scratch("negative");
+    let out = dir.to_string_lossy().to_string();
+    let r = run(&[
+        "export",
+        "reports/fit/params.json",
+        "--engine",
+        "lammps",
+        "--v-range",
+        "0.5,40",
+        "--mu0",
+        "0.3",
+        "--beta0",
+        "-0.5",
+        "--out",
+        &out,
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let doc: serde_json::Value = serde_json::from_str(&read(&dir, "export.json")).unwrap();
+    assert!(
+        r.stdout.contains("beta_0 = -0.500 (given)") && doc.to_string().contains("\"beta0\":-0.5"),
+        "{}",
+        r.stdout
+    );
+}

@@ -627,3 +627,47 @@ fn figures_draw_a_marker_once_per_pixel_and_many_as_a_density() {
     assert_eq!(res.matches("<circle").count(), 1);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A negative number is a flag's value: a Poisson ratio lies in (-1, 0.5), and `--poisson -0.2`
+/// was read as the short flags `-0` and `.2` ("unexpected argument '-0' found"); `predict` too.
+#[test]
+fn negative_values_are_values() {
+    let material = [
+        "--youngs-pa",
+        "1e9",
+        "--poisson",
+        "-0.2",
+        "--density-kg-m3",
+        "1000",
+    ];
+    let mut fit = vec!["fit", "data/fig7_nylon.csv", "--model", "vm"];
+    fit.extend(material);
+    let r = run(&fit);
+    assert!(r.ok, "{}", r.stderr);
+    assert!(r.stdout.contains("nu = -0.2,"), "{}", r.stdout);
+    let mut predict = vec!["predict", "--model", "vm", "--d-mm", "10", "--eta", "200"];
+    predict.extend(material);
+    predict.extend(["--v-m-s", "1", "--format", "json"]);
+    let r = run(&predict);
+    assert!(r.ok, "{}", r.stderr);
+    // A negative damping is now the value's own error, naming the flag.
+    let r = run(&[
+        "predict",
+        "--model",
+        "vm",
+        "--material",
+        "nylon",
+        "--d-mm",
+        "10",
+        "--eta",
+        "-5",
+        "--v-m-s",
+        "1",
+    ]);
+    assert!(!r.ok);
+    assert!(
+        r.stderr.starts_with("restitution: error: --eta -5: "),
+        "{}",
+        r.stderr
+    );
+}

@@ -140,3 +140,58 @@ fn bad_rendering_flags_are_one_line_errors_and_write_nothing() {
         assert!(!out.join("tracks.csv").exists() && !frames.join("truth.csv").exists());
     }
 }
+
+/// The physics flags' errors name the flag and its values: a speed or angle range out of order
+/// or out of bounds, and a model that cannot be evaluated at the range's ends (V_Y underflowing
+/// for a tiny sigma_y). They were reported as "the virtual experiment failed with" every physics
+/// flag, defaults included, and the library's name for the quantity.
+#[test]
+fn bad_physics_flags_name_themselves() {
+    for (extra, says) in [
+        (
+            &["--v-n-m-s", "2,1"][..],
+            "--v-n-m-s 2,1: expected speeds 0 < MIN <= MAX (m/s)",
+        ),
+        (
+            &["--v-n-m-s", "1,inf"][..],
+            "--v-n-m-s 1,inf: expected speeds",
+        ),
+        (
+            &["--v-n-m-s", "1,2", "--incidence-deg", "90,90"][..],
+            "--incidence-deg 90,90: expected angles 0 <= MIN <= MAX < 90 (degrees)",
+        ),
+        (
+            &[
+                "--v-n-m-s",
+                "1,2",
+                "--model",
+                "pm",
+                "--sigma-y-pa",
+                "1e-200",
+            ][..],
+            "--sigma-y-pa 1e-200 (--model pm, v_n = 1 m/s): V_Y (m/s) = 0 is out of the range of f64 \
+             (underflow)",
+        ),
+    ] {
+        let out = tmp("physics");
+        let mut args = vec![
+            "simulate",
+            "--material",
+            "nylon",
+            "--n",
+            "2",
+            "--out",
+            s(&out),
+        ];
+        args.extend(extra);
+        let o = run(&args);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{extra:?} was accepted");
+        assert_eq!(err.trim().lines().count(), 1, "{extra:?}: {err}");
+        assert!(
+            err.starts_with(&format!("restitution: error: {says}")),
+            "{err}"
+        );
+        assert!(!out.join("tracks.csv").exists());
+    }
+}

@@ -65,6 +65,7 @@ pub enum WeightArg {
 
 /// A fitted contact law as simulation-engine input
 #[derive(clap::Args, Debug)]
+#[command(allow_negative_numbers = true)]
 pub struct Args {
     /// params.json written by `restitution fit --out`
     #[arg(value_name = "PARAMS.json")]

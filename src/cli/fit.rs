@@ -42,6 +42,7 @@ pub enum ModelArg {
 
 /// Fit models of e(v_n) to measured coefficients of restitution
 #[derive(clap::Args, Debug)]
+#[command(allow_negative_numbers = true)]
 pub struct Args {
     /// CSV with columns d_mm, v_n_m_s, e [, e_err | v_err_m_s] [, d2_mm]
     #[arg(value_name = "DATA.csv")]

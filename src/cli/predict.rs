@@ -41,6 +41,7 @@ pub enum MethodArg {
 
 /// e(v) from the viscoelastic or plastic model
 #[derive(clap::Args, Debug)]
+#[command(allow_negative_numbers = true)]
 pub struct Args {
     #[arg(long, value_enum)]
     model: Model,

@@ -142,6 +142,16 @@ fn check(flag: &str, v: f64, ok: bool, expected: &str) -> CliResult {
     }
 }
 
+/// [`check`] for a flag of two values MIN,MAX.
+fn check_range(flag: &str, r: &[f64], ok: bool, expected: &str) -> CliResult {
+    if r.iter().all(|v| v.is_finite()) && ok {
+        Ok(())
+    } else {
+        let values: Vec<String> = r.iter().map(|&v| fmt_num(v)).collect();
+        Err(format!("{flag} {}: expected {expected}", values.join(",")))
+    }
+}
+
 pub fn run(args: Args) -> CliResult {
     for (flag, n) in [
         ("--v-n-m-s", args.v_n_m_s.len()),
@@ -162,6 +172,19 @@ pub fn run(args: Args) -> CliResult {
         args.sigma_y_pa,
         args.sigma_y_pa > 0.0,
         "a stress > 0",
+    )?;
+    let (v, g) = (&args.v_n_m_s, &args.incidence_deg);
+    check_range(
+        "--v-n-m-s",
+        v,
+        v[0] > 0.0 && v[1] >= v[0],
+        "speeds 0 < MIN <= MAX (m/s)",
+    )?;
+    check_range(
+        "--incidence-deg",
+        g,
+        (0.0..90.0).contains(&g[0]) && (g[0]..90.0).contains(&g[1]),
+        "angles 0 <= MIN <= MAX < 90 (degrees)",
     )?;
     check(
         "--mu0",
@@ -305,6 +328,27 @@ pub fn run(args: Args) -> CliResult {
             &VmMethod::Master,
         )
     };
+    // The model at both ends of the speed range first: what can fail (V_Y under- or
+    // overflowing with sigma_y, kappa overflowing with eta at the fastest speed) fails at an end
+    // if anywhere, and is named by the model's parameters rather than by every physics flag.
+    for v in &args.v_n_m_s {
+        e_of(*v).map_err(|e| {
+            let flags = match args.model {
+                ModelKind::Vm => format!("--eta {}", fmt_num(args.eta)),
+                ModelKind::Pm => format!("--sigma-y-pa {}", fmt_num(args.sigma_y_pa)),
+                _ => format!(
+                    "--eta {} --sigma-y-pa {}",
+                    fmt_num(args.eta),
+                    fmt_num(args.sigma_y_pa)
+                ),
+            };
+            format!(
+                "{flags} (--model {}, v_n = {} m/s): {e}",
+                args.model.name(),
+                fmt_num(*v)
+            )
+        })?;
+    }
     let mut rng = StdRng::seed_from_u64(args.seed);
     if args.camera_study && args.render.wanted() {
         return Err("--frames-out renders a simulation, not the camera study".into());
