@@ -174,3 +174,75 @@ fn the_files_say_how_many_collisions_were_skipped() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Flags every collision depends on are checked by name: with `--inertia-k 1e300` (Walton's
+/// bodies take K in (0, 1]) or `--fixed-gravity --g-m-s2 1e300` every collision was skipped and
+/// the error gave the first collision's own reason; where a whole file cannot be measured the
+/// error now says so.
+#[test]
+fn flags_that_no_collision_survives_are_named() {
+    for (tag, flags, named) in [
+        (
+            "k",
+            &["--inertia-k", "1e300"][..],
+            "--inertia-k 1e300: expected a number in (0, 1]",
+        ),
+        (
+            "g",
+            &["--fixed-gravity", "--g-m-s2", "1e300"][..],
+            "--g-m-s2 1e300: expected at most 1000000 m/s^2",
+        ),
+    ] {
+        let (ok, stdout, stderr) = kinematics_with(tag, flags);
+        assert!(!ok && stdout.is_empty(), "{flags:?}: {stdout}");
+        assert!(
+            stderr.starts_with(&format!("restitution: error: {named}")),
+            "{stderr}"
+        );
+        assert_eq!(stderr.trim_end().lines().count(), 1, "{stderr}");
+    }
+    // Every collision of a file too short to measure: the error counts them.
+    let text = tracks();
+    let mut lines = text.lines();
+    let head = lines.next().unwrap();
+    let id = head.split(',').position(|c| c == "collision").unwrap();
+    let first_id = lines
+        .clone()
+        .next()
+        .unwrap()
+        .split(',')
+        .nth(id)
+        .unwrap()
+        .to_string();
+    // Two copies of the first collision's first two frames, under two ids.
+    let rows: Vec<&str> = lines
+        .filter(|l| l.split(',').nth(id) == Some(&first_id))
+        .take(2)
+        .collect();
+    let mut short = vec![head.to_string()];
+    for copy in ["a", "b"] {
+        for r in &rows {
+            let mut f: Vec<&str> = r.split(',').collect();
+            f[id] = copy;
+            short.push(f.join(","));
+        }
+    }
+    let dir = std::env::temp_dir().join(format!("restitution-kin-none-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("tracks.csv");
+    std::fs::write(&path, short.join("\n") + "\n").unwrap();
+    let o = Command::new(bin())
+        .args(["kinematics", path.to_str().unwrap(), "--material", "nylon"])
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let err = String::from_utf8(o.stderr).unwrap();
+    assert!(!o.status.success());
+    assert!(
+        err.starts_with("restitution: error: none of the 2 collisions of ")
+            && err.contains("could be measured; the first: ")
+            && err.contains("collision 'a'"),
+        "{err}"
+    );
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+}

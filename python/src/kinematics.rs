@@ -11,8 +11,8 @@ use restitution::data::report::kinematics::{Measured, Row, kinematics_json, meas
 use restitution::data::tracks::parse_tracks;
 use restitution::experiment::Camera;
 use restitution::kinematics::batch::BatchOptions;
-use restitution::kinematics::{Eq8Inputs, FitKind, G_STANDARD_M_S2};
-use restitution::models::walton::K_HOMOGENEOUS;
+use restitution::kinematics::{Eq8Inputs, FitKind, G_MAX_M_S2, G_STANDARD_M_S2};
+use restitution::models::walton::{INERTIA_K_EXPECTED, K_HOMOGENEOUS, inertia_k_ok};
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(kinematics, m)?)?;
@@ -73,7 +73,6 @@ fn kinematics<'py>(
             ("s_subpixels", s_subpixels),
             ("fov_m", fov_m),
             ("subpixel_expansion", subpixel_expansion),
-            ("inertia_k", inertia_k),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(Failure::Input(format!(
@@ -81,6 +80,19 @@ fn kinematics<'py>(
                     fmt_num(v)
                 )));
             }
+        }
+        if !inertia_k_ok(inertia_k) {
+            return Err(Failure::Input(format!(
+                "inertia_k = {}: expected {INERTIA_K_EXPECTED}",
+                fmt_num(inertia_k)
+            )));
+        }
+        if g_m_s2 > G_MAX_M_S2 {
+            return Err(Failure::Input(format!(
+                "g_m_s2 = {}: expected at most {} m/s^2 (1e5 g, a centrifuge's)",
+                fmt_num(g_m_s2),
+                fmt_num(G_MAX_M_S2)
+            )));
         }
         if pixels_x == 0 {
             return Err(Failure::Input(
@@ -121,8 +133,8 @@ fn kinematics<'py>(
             eq8,
         };
         let measured = measure_tracks(&table.path, &tracks, &options);
-        if !measured.skipped.is_empty() && (strict || measured.rows.is_empty()) {
-            return Err(Failure::Input(measured.skipped[0].clone()));
+        if let Some(why) = measured.refusal(&table.path, strict) {
+            return Err(Failure::Input(why));
         }
         let json = kinematics_json(&measured.rows);
         Ok(Done {

@@ -47,6 +47,13 @@ fn walton_fit<'py>(
     };
     let (json, warnings) = run_detached(py, move || -> Outcome<(String, Vec<String>)> {
         let (material, weights) = (material?, weights?);
+        if !restitution::models::walton::inertia_k_ok(inertia_k) {
+            return Err(Failure::Input(format!(
+                "inertia_k = {}: expected {}",
+                restitution::data::fmt_num(inertia_k),
+                restitution::models::walton::INERTIA_K_EXPECTED
+            )));
+        }
         if bootstrap == 1 {
             return Err(Failure::Input(
                 "bootstrap = 1: expected 0 (no intervals) or at least 2 resamples".into(),

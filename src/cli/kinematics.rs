@@ -27,7 +27,7 @@ use restitution::data::walton::write_collisions;
 use restitution::data::{CsvOut, fmt_num, write_all_atomic};
 use restitution::experiment::Camera;
 use restitution::kinematics::batch::BatchOptions;
-use restitution::kinematics::{Eq8Inputs, FitKind, G_STANDARD_M_S2};
+use restitution::kinematics::{Eq8Inputs, FitKind, G_MAX_M_S2, G_STANDARD_M_S2};
 use restitution::models::walton::K_HOMOGENEOUS;
 use std::path::PathBuf;
 
@@ -43,7 +43,7 @@ pub struct Args {
     /// Fit straight lines plus the known gravity (y up) instead of free quadratics
     #[arg(long = "fixed-gravity")]
     fixed_gravity: bool,
-    /// Gravitational acceleration for --fixed-gravity, m/s^2
+    /// Gravitational acceleration for --fixed-gravity, m/s^2 (at most 1e6)
     #[arg(long = "g-m-s2", value_name = "G", default_value_t = G_STANDARD_M_S2)]
     g_m_s2: f64,
     /// Inertia factor K = 4I/(m d^2) (2/5 for homogeneous spheres)
@@ -89,11 +89,18 @@ pub fn run(args: Args) -> CliResult {
         ("--s-subpixels", args.s_subpixels),
         ("--fov-m", args.fov_m),
         ("--subpixel-expansion", args.subpixel_expansion),
-        ("--inertia-k", args.inertia_k),
     ] {
         if !(v.is_finite() && v > 0.0) {
             return Err(format!("{flag} {}: expected a number > 0", fmt_num(v)));
         }
+    }
+    super::check_inertia_k(args.inertia_k)?;
+    if args.g_m_s2 > G_MAX_M_S2 {
+        return Err(format!(
+            "--g-m-s2 {}: expected at most {} m/s^2 (1e5 g, a centrifuge's)",
+            fmt_num(args.g_m_s2),
+            fmt_num(G_MAX_M_S2)
+        ));
     }
     if args.pixels_x == 0 {
         return Err("--pixels-x 0: expected a pixel count > 0".into());
@@ -147,21 +154,22 @@ pub fn run(args: Args) -> CliResult {
     // The noise pooled over every collision; a collision that cannot be measured (too few
     // frames, receding spheres) is skipped with a warning naming it, so one bad track does not
     // lose a campaign; --strict makes it an error.
+    let measured = measure_tracks(&shown, &tracks, &options);
+    for line in &measured.unmeasured_spins {
+        super::warn(line);
+    }
+    if let Some(why) = measured.refusal(&shown, args.strict) {
+        return Err(why);
+    }
     let Measured {
         rows,
         records,
         skipped,
-        unmeasured_spins,
         fits_meet,
         sigma_pos_m: sigma,
-    } = measure_tracks(&shown, &tracks, &options);
-    for line in &unmeasured_spins {
-        super::warn(line);
-    }
+        ..
+    } = measured;
     if !skipped.is_empty() {
-        if args.strict || rows.is_empty() {
-            return Err(skipped[0].clone());
-        }
         // One line each, up to a screenful; a file of 100 000 bad tracks gets a count.
         for s in skipped.iter().take(MAX_WARNINGS) {
             super::warn(format_args!("skipped {s}"));

@@ -40,6 +40,21 @@ pub fn warn(message: impl std::fmt::Display) {
     let _ = writeln!(io::stderr(), "restitution: warning: {message}");
 }
 
+/// `--inertia-k K` of `walton fit` and `kinematics`, checked here so that the flag is named (in
+/// `kinematics` every collision was skipped for it and the error named the first collision's
+/// own reason).
+pub fn check_inertia_k(k: f64) -> CliResult {
+    use restitution::models::walton::{INERTIA_K_EXPECTED, inertia_k_ok};
+    if inertia_k_ok(k) {
+        Ok(())
+    } else {
+        Err(format!(
+            "--inertia-k {}: expected {INERTIA_K_EXPECTED}",
+            restitution::data::fmt_num(k)
+        ))
+    }
+}
+
 /// Material flags shared by the subcommands: a preset or the three constants.
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct MaterialArgs {

@@ -40,6 +40,11 @@ pub use polyfit::{PhaseFit, PolyFit};
 /// Standard gravity, m/s^2.
 pub const G_STANDARD_M_S2: f64 = 9.80665;
 
+/// The largest gravity a fixed-gravity fit is given by the front ends, m/s^2 (1e5 g, a
+/// centrifuge's): at 1e300 every collision's fit overflowed and was skipped, and the error
+/// named the first collision's own reason instead of the gravity.
+pub const G_MAX_M_S2: f64 = 1e6;
+
 /// How each coordinate is fitted in time.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum FitKind {

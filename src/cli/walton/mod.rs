@@ -110,12 +110,7 @@ pub fn run(args: Args) -> CliResult {
 }
 
 fn run_fit(a: FitArgs) -> CliResult {
-    if !(a.inertia_k.is_finite() && a.inertia_k > 0.0 && a.inertia_k <= 1.0) {
-        return Err(format!(
-            "--inertia-k {}: expected a number in (0, 1] (K = 4I/(m d^2); 0.4 for a homogeneous sphere)",
-            restitution::data::fmt_num(a.inertia_k)
-        ));
-    }
+    super::check_inertia_k(a.inertia_k)?;
     if a.bootstrap == 1 {
         return Err("--bootstrap 1: expected 0 (no intervals) or at least 2 resamples".into());
     }

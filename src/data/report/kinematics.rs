@@ -174,6 +174,25 @@ pub struct Measured {
 /// Measures every collision of `tracks` (read from `shown`). A collision whose numbers
 /// overflow (absurd magnitudes in the tracks or options) is skipped like an unmeasurable one,
 /// never reported as NaN or inf.
+impl Measured {
+    /// The error line of a run that cannot go on, if it cannot: with `strict`, the first
+    /// collision skipped; without, where no collision of `shown` could be measured, that, with
+    /// the first one's reason (the others' may differ: the first alone read as the reason for
+    /// all of them).
+    pub fn refusal(&self, shown: &str, strict: bool) -> Option<String> {
+        let first = self.skipped.first()?;
+        if strict || self.rows.is_empty() && self.skipped.len() == 1 {
+            return Some(first.clone());
+        }
+        self.rows.is_empty().then(|| {
+            format!(
+                "none of the {} collisions of {shown} could be measured; the first: {first}",
+                self.skipped.len()
+            )
+        })
+    }
+}
+
 pub fn measure_tracks(shown: &str, tracks: &[CollisionTrack], options: &BatchOptions) -> Measured {
     let place = |t: &CollisionTrack| {
         format!(

@@ -33,6 +33,17 @@ pub use measure::{Measured, measure};
 /// Inertia factor K = 4I/(m d^2) of a homogeneous sphere (I = m d^2/10).
 pub const K_HOMOGENEOUS: f64 = 0.4;
 
+/// Whether `k` is an inertia factor a body can have: K = 4I/(m d^2) in (0, 1] (2/3 for a thin
+/// spherical shell; 1 would put all the mass on the equator). What the front ends say
+/// otherwise: [`INERTIA_K_EXPECTED`].
+pub fn inertia_k_ok(k: f64) -> bool {
+    k.is_finite() && k > 0.0 && k <= 1.0
+}
+
+/// The range of [`inertia_k_ok`], as an error line states it.
+pub const INERTIA_K_EXPECTED: &str =
+    "a number in (0, 1] (K = 4I/(m d^2); 0.4 for a homogeneous sphere)";
+
 /// A rigid sphere at the instant of contact. SI units.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Body {
@@ -110,7 +121,7 @@ impl Body {
         if !(self.mass_kg.is_finite() && self.mass_kg > 0.0) {
             return bad("sphere mass (kg)", self.mass_kg, "a finite number > 0");
         }
-        if !(self.inertia_k.is_finite() && self.inertia_k > 0.0 && self.inertia_k <= 1.0) {
+        if !inertia_k_ok(self.inertia_k) {
             return bad(
                 "inertia factor K = 4I/(m d^2)",
                 self.inertia_k,
