@@ -171,9 +171,6 @@ pub struct Measured {
     pub fits_meet: Vec<String>,
 }
 
-/// Measures every collision of `tracks` (read from `shown`). A collision whose numbers
-/// overflow (absurd magnitudes in the tracks or options) is skipped like an unmeasurable one,
-/// never reported as NaN or inf.
 impl Measured {
     /// The error line of a run that cannot go on, if it cannot: with `strict`, the first
     /// collision skipped; without, where no collision of `shown` could be measured, that, with
@@ -193,6 +190,9 @@ impl Measured {
     }
 }
 
+/// Measures every collision of `tracks` (read from `shown`). A collision whose numbers
+/// overflow (absurd magnitudes in the tracks or options) is skipped like an unmeasurable one,
+/// never reported as NaN or inf.
 pub fn measure_tracks(shown: &str, tracks: &[CollisionTrack], options: &BatchOptions) -> Measured {
     let place = |t: &CollisionTrack| {
         format!(
