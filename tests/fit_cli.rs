@@ -134,9 +134,11 @@ fn json_shape_is_stable() {
             "comparison",
             "preferred",
             "preferred_rule",
+            "unranked",
             "skipped_models"
         ]
     );
+    assert_eq!(v["unranked"], serde_json::Value::Null);
     assert_eq!(
         keys(&v["data"]),
         ["path", "n", "diameters_mm", "wall", "errors"]
@@ -670,4 +672,59 @@ fn negative_values_are_values() {
         "{}",
         r.stderr
     );
+}
+
+/// Points that every model reproduces to rounding (three identical rows at one speed,
+/// unweighted) leave AIC nothing to rank: no model is named preferred (`min` had been, on an AIC
+/// of -inf), the differences and weights are not shown, and `export` then asks for a model.
+#[test]
+fn exact_fits_are_not_ranked_by_aic() {
+    let dir = scratch("exact");
+    let path = write(
+        &dir,
+        "same.csv",
+        "d_mm,v_n_m_s,e\n10,1,0.9\n10,1,0.9\n10,1,0.9\n",
+    );
+    let out = dir.join("out");
+    let r = run(&[
+        "fit",
+        &path,
+        "--material",
+        "nylon",
+        "--model",
+        "all",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    assert!(
+        r.stdout.contains(
+            "preferred model: none (vm, pm, min, product reproduce the points to rounding \
+             (residual sum of squares at most 1e-24 per point), where AIC ranks rounding, not fit)"
+        ),
+        "{}",
+        r.stdout
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("params.json")).unwrap()).unwrap();
+    assert_eq!(v["preferred"], serde_json::Value::Null);
+    assert!(
+        v["unranked"]
+            .as_str()
+            .unwrap()
+            .contains("reproduce the points to rounding")
+    );
+    for row in v["comparison"].as_array().unwrap() {
+        assert_eq!(row["delta_aic"], serde_json::Value::Null, "{row}");
+        assert_eq!(row["akaike_weight"], serde_json::Value::Null, "{row}");
+    }
+    let r = run(&[
+        "export",
+        out.join("params.json").to_str().unwrap(),
+        "--engine",
+        "lammps",
+    ]);
+    assert!(!r.ok);
+    assert_eq!(r.stderr.trim_end().lines().count(), 1, "{}", r.stderr);
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -31,7 +31,11 @@ class FitResult:
     Attributes
     ----------
     preferred : str or None
-        The model preferred by AIC (within delta AIC <= 2, the fewest parameters).
+        The model preferred by AIC (within delta AIC <= 2, the fewest parameters); None where no
+        fit converged or AIC cannot rank the fits (``unranked`` says why).
+    unranked : str or None
+        Why no model is preferred: no fit converged, or a model reproduces unweighted points to
+        rounding, where AIC would rank rounding.
     models : list of str
         The fitted models, in the document's order.
     params : dict
@@ -58,6 +62,10 @@ class FitResult:
     @property
     def preferred(self) -> Optional[str]:
         return self._doc["preferred"]
+
+    @property
+    def unranked(self) -> Optional[str]:
+        return self._doc["unranked"]
 
     @property
     def models(self) -> List[str]:

@@ -88,6 +88,16 @@ def test_fit_accessors_read_the_document(in_root):
     assert sum(len(f["params"]) for f in doc["fits"]) == len(rows)
     html = r._repr_html_()
     assert "<svg" in html and "preferred" in html
+    assert r.unranked is None
+
+
+def test_exact_fits_leave_no_model_preferred():
+    # Three identical rows at one speed: every model reproduces them to rounding, and AIC
+    # (n ln(RSS/n) + 2k, -inf for two of them) has nothing to rank.
+    r = rs.fit({"d_mm": [10, 10, 10], "v_n_m_s": [1, 1, 1], "e": [0.9, 0.9, 0.9]}, "nylon")
+    assert r.preferred is None
+    assert "reproduce the points to rounding" in r.unranked
+    assert all(c["delta_aic"] is None for c in r.to_dict()["comparison"])
 
 
 def predict_rows(*args):

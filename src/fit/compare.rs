@@ -5,7 +5,9 @@
 //! relative support of model i within the set. The preferred model follows Burnham & Anderson's
 //! rule of thumb that models within Delta AIC <= 2 have substantial support: among the converged
 //! fits within 2 of the best, the one with the fewest parameters (then the lower AIC) is named,
-//! so that the data are not described with more than they support.
+//! so that the data are not described with more than they support. Unweighted fits that
+//! reproduce the points to rounding leave AIC nothing to rank ([`EXACT_RSS_PER_POINT`];
+//! docs/physics.md §7.6): no model is named then, and [`Comparison::unranked`] says why.
 
 use super::models::ModelKind;
 use super::result::FitResult;
@@ -30,9 +32,19 @@ pub struct ComparisonRow {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Comparison {
     pub rows: Vec<ComparisonRow>,
-    /// `None` when no fit converged.
+    /// `None` when no fit converged, or when AIC cannot rank the fits (see `unranked`).
     pub preferred: Option<ModelKind>,
+    /// Why no model is preferred, when none is.
+    pub unranked: Option<String>,
 }
+
+/// Residual sum of squares per point (unweighted fits) at or below which a model reproduces the
+/// points exactly: its residuals of e are then below 1e-12, the rounding of e's evaluation
+/// (the master curve's is about 1e-14), far below any measurement's error. There
+/// AIC = n ln(RSS/n) + 2k ranks rounding, not fit: on three identical rows at one speed `vm` and
+/// `pm` had RSS 9e-29 and 1e-24, `min` and `product` exactly 0 (AIC = -inf), and `min` was named
+/// the preferred model of data that no model can tell apart.
+pub const EXACT_RSS_PER_POINT: f64 = 1e-24;
 
 /// Compares fitted models of the same data (their AICs are only comparable then).
 pub fn compare(fits: &[FitResult]) -> Comparison {
@@ -57,6 +69,38 @@ pub fn compare(fits: &[FitResult]) -> Comparison {
             converged: f.converged,
         })
         .collect();
+    // A fit to rounding (or an AIC that is not a number) leaves AIC nothing to rank: no
+    // differences, weights or preference are shown.
+    let exact: Vec<&str> = fits
+        .iter()
+        .filter(|f| !f.aic.is_finite() || !f.weighted && f.chi2 <= EXACT_RSS_PER_POINT * f.n as f64)
+        .map(|f| f.model.name())
+        .collect();
+    if !exact.is_empty() {
+        let rows = rows
+            .into_iter()
+            .map(|r| ComparisonRow {
+                delta_aic: f64::NAN,
+                akaike_weight: f64::NAN,
+                ..r
+            })
+            .collect();
+        return Comparison {
+            rows,
+            preferred: None,
+            unranked: Some(format!(
+                "{} {} the points to rounding (residual sum of squares at most {:e} per point), \
+                 where AIC ranks rounding, not fit",
+                exact.join(", "),
+                if exact.len() == 1 {
+                    "reproduces"
+                } else {
+                    "reproduce"
+                },
+                EXACT_RSS_PER_POINT
+            )),
+        };
+    }
     let best_conv = rows
         .iter()
         .filter(|r| r.converged)
@@ -67,5 +111,10 @@ pub fn compare(fits: &[FitResult]) -> Comparison {
         .filter(|r| r.converged && r.aic <= best_conv + 2.0)
         .min_by(|a, b| a.k.cmp(&b.k).then(a.aic.total_cmp(&b.aic)))
         .map(|r| r.model);
-    Comparison { rows, preferred }
+    let unranked = preferred.is_none().then(|| "no fit converged".to_string());
+    Comparison {
+        rows,
+        preferred,
+        unranked,
+    }
 }

@@ -164,6 +164,7 @@ pub fn to_json(ctx: &ReportContext, set: &FitSet) -> Value {
         "comparison": comparison,
         "preferred": preferred,
         "preferred_rule": PREFERENCE_RULE,
+        "unranked": set.comparison.as_ref().and_then(|c| c.unranked.clone()),
         "skipped_models": set.skipped.iter().map(|k| k.name()).collect::<Vec<_>>(),
     })
 }

@@ -325,7 +325,10 @@ fn preferred_line(set: &FitSet) -> Option<String> {
     let c = set.comparison.as_ref()?;
     Some(match c.preferred {
         Some(m) => format!("preferred model: {} ({PREFERENCE_RULE})", m.name()),
-        None => "preferred model: none (no fit converged)".into(),
+        None => format!(
+            "preferred model: none ({})",
+            c.unranked.as_deref().unwrap_or("no fit converged")
+        ),
     })
 }
 
