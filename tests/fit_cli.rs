@@ -728,3 +728,53 @@ fn exact_fits_are_not_ranked_by_aic() {
     assert_eq!(r.stderr.trim_end().lines().count(), 1, "{}", r.stderr);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Points made by one model (`predict`'s e of `vm`, shortest round-trip) are reproduced to
+/// rounding by it and by `min` and `product` (sigma_y where no point yields): AIC cannot rank
+/// them, but `vm` alone has the fewest parameters among them, and is named, saying why.
+#[test]
+fn a_model_that_made_the_points_is_named_among_exact_fits() {
+    let p = run(&[
+        "predict",
+        "--model",
+        "vm",
+        "--material",
+        "nylon",
+        "--d-mm",
+        "10",
+        "--eta",
+        "200",
+        "--v-m-s",
+        "0.5,1,2,4,8",
+        "--format",
+        "csv",
+    ]);
+    assert!(p.ok, "{}", p.stderr);
+    let mut csv = String::from("d_mm,v_n_m_s,e\n");
+    for line in p.stdout.lines().skip(1) {
+        let f: Vec<&str> = line.split(',').collect();
+        csv += &format!("10,{},{}\n", f[0], f[1]);
+    }
+    let dir = scratch("made");
+    let path = write(&dir, "vm.csv", &csv);
+    let r = run(&[
+        "fit",
+        &path,
+        "--material",
+        "nylon",
+        "--model",
+        "all",
+        "--format",
+        "json",
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let v: serde_json::Value = serde_json::from_str(&r.stdout).unwrap();
+    assert_eq!(v["preferred"], "vm", "{}", v["unranked"]);
+    let why = v["unranked"].as_str().unwrap();
+    assert!(
+        why.starts_with("vm, ") && why.ends_with("; vm has the fewest parameters among them"),
+        "{why}"
+    );
+    assert!(!why.contains("pm,"), "pm cannot make these points: {why}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -31,11 +31,12 @@ class FitResult:
     Attributes
     ----------
     preferred : str or None
-        The model preferred by AIC (within delta AIC <= 2, the fewest parameters); None where no
-        fit converged or AIC cannot rank the fits (``unranked`` says why).
+        The model preferred by AIC (within delta AIC <= 2, the fewest parameters); where models
+        reproduce unweighted points to rounding, the one of them with the fewest parameters if
+        one alone has them; None where no fit converged or none is so chosen.
     unranked : str or None
-        Why no model is preferred: no fit converged, or a model reproduces unweighted points to
-        rounding, where AIC would rank rounding.
+        Why AIC did not choose: no fit converged, or models reproduce the points to rounding,
+        where AIC would rank rounding.
     models : list of str
         The fitted models, in the document's order.
     params : dict

@@ -7,7 +7,8 @@
 //! fits within 2 of the best, the one with the fewest parameters (then the lower AIC) is named,
 //! so that the data are not described with more than they support. Unweighted fits that
 //! reproduce the points to rounding leave AIC nothing to rank ([`EXACT_RSS_PER_POINT`];
-//! docs/physics.md §7.6): no model is named then, and [`Comparison::unranked`] says why.
+//! docs/physics.md §7.6): the one of them with the fewest parameters is named if one alone has
+//! them, else none, and [`Comparison::unranked`] says why.
 
 use super::models::ModelKind;
 use super::result::FitResult;
@@ -34,7 +35,8 @@ pub struct Comparison {
     pub rows: Vec<ComparisonRow>,
     /// `None` when no fit converged, or when AIC cannot rank the fits (see `unranked`).
     pub preferred: Option<ModelKind>,
-    /// Why no model is preferred, when none is.
+    /// Why AIC did not choose: no fit converged, or fits that reproduce the points to rounding
+    /// (then the one with the fewest parameters, if one alone has them, is `preferred`).
     pub unranked: Option<String>,
 }
 
@@ -70,11 +72,12 @@ pub fn compare(fits: &[FitResult]) -> Comparison {
         })
         .collect();
     // A fit to rounding (or an AIC that is not a number) leaves AIC nothing to rank: no
-    // differences, weights or preference are shown.
-    let exact: Vec<&str> = fits
+    // differences or weights are shown, and a model is named only where one alone has the
+    // fewest parameters among the converged fits that reproduce the points (data made by a
+    // model: that model; data every model reproduces, as one speed repeated: none).
+    let exact: Vec<&FitResult> = fits
         .iter()
         .filter(|f| !f.aic.is_finite() || !f.weighted && f.chi2 <= EXACT_RSS_PER_POINT * f.n as f64)
-        .map(|f| f.model.name())
         .collect();
     if !exact.is_empty() {
         let rows = rows
@@ -85,20 +88,36 @@ pub fn compare(fits: &[FitResult]) -> Comparison {
                 ..r
             })
             .collect();
+        let names: Vec<&str> = exact.iter().map(|f| f.model.name()).collect();
+        let why = format!(
+            "{} {} the points to rounding (residual sum of squares at most {:e} per point), \
+             where AIC ranks rounding, not fit",
+            names.join(", "),
+            if names.len() == 1 {
+                "reproduces"
+            } else {
+                "reproduce"
+            },
+            EXACT_RSS_PER_POINT
+        );
+        let converged: Vec<&&FitResult> = exact.iter().filter(|f| f.converged).collect();
+        let fewest = converged.iter().map(|f| f.k()).min();
+        let alone: Vec<ModelKind> = converged
+            .iter()
+            .filter(|f| Some(f.k()) == fewest)
+            .map(|f| f.model)
+            .collect();
+        let (preferred, unranked) = match alone[..] {
+            [m] => (
+                Some(m),
+                format!("{why}; {} has the fewest parameters among them", m.name()),
+            ),
+            _ => (None, why),
+        };
         return Comparison {
             rows,
-            preferred: None,
-            unranked: Some(format!(
-                "{} {} the points to rounding (residual sum of squares at most {:e} per point), \
-                 where AIC ranks rounding, not fit",
-                exact.join(", "),
-                if exact.len() == 1 {
-                    "reproduces"
-                } else {
-                    "reproduce"
-                },
-                EXACT_RSS_PER_POINT
-            )),
+            preferred,
+            unranked: Some(unranked),
         };
     }
     let best_conv = rows

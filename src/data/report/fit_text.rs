@@ -323,13 +323,9 @@ fn correlation_lines(set: &FitSet) -> Vec<String> {
 
 fn preferred_line(set: &FitSet) -> Option<String> {
     let c = set.comparison.as_ref()?;
-    Some(match c.preferred {
-        Some(m) => format!("preferred model: {} ({PREFERENCE_RULE})", m.name()),
-        None => format!(
-            "preferred model: none ({})",
-            c.unranked.as_deref().unwrap_or("no fit converged")
-        ),
-    })
+    let name = c.preferred.map_or("none", |m| m.name());
+    let why = c.unranked.as_deref().unwrap_or(PREFERENCE_RULE);
+    Some(format!("preferred model: {name} ({why})"))
 }
 
 fn note_lines(set: &FitSet) -> Vec<String> {
