@@ -190,7 +190,7 @@ fn flags_that_no_collision_survives_are_named() {
         (
             "g",
             &["--fixed-gravity", "--g-m-s2", "1e300"][..],
-            "--g-m-s2 1e300: expected at most 1000000 m/s^2",
+            "--g-m-s2 1e300: expected a number > 0, at most 1e6 m/s^2 (1e5 g, a centrifuge's)",
         ),
     ] {
         let (ok, stdout, stderr) = kinematics_with(tag, flags);

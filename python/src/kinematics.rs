@@ -11,7 +11,7 @@ use restitution::data::report::kinematics::{Measured, Row, kinematics_json, meas
 use restitution::data::tracks::parse_tracks;
 use restitution::experiment::Camera;
 use restitution::kinematics::batch::BatchOptions;
-use restitution::kinematics::{Eq8Inputs, FitKind, G_MAX_M_S2, G_STANDARD_M_S2};
+use restitution::kinematics::{Eq8Inputs, FitKind, G_EXPECTED, G_STANDARD_M_S2, g_ok};
 use restitution::models::walton::{INERTIA_K_EXPECTED, K_HOMOGENEOUS, inertia_k_ok};
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -69,7 +69,6 @@ fn kinematics<'py>(
     let done = run_detached(py, move || -> Outcome<Done> {
         let material = material?;
         for (arg, v) in [
-            ("g_m_s2", g_m_s2),
             ("s_subpixels", s_subpixels),
             ("fov_m", fov_m),
             ("subpixel_expansion", subpixel_expansion),
@@ -87,11 +86,10 @@ fn kinematics<'py>(
                 fmt_num(inertia_k)
             )));
         }
-        if g_m_s2 > G_MAX_M_S2 {
+        if !g_ok(g_m_s2) {
             return Err(Failure::Input(format!(
-                "g_m_s2 = {}: expected at most {} m/s^2 (1e5 g, a centrifuge's)",
-                fmt_num(g_m_s2),
-                fmt_num(G_MAX_M_S2)
+                "g_m_s2 = {}: expected {G_EXPECTED}",
+                fmt_num(g_m_s2)
             )));
         }
         if pixels_x == 0 {

@@ -27,7 +27,7 @@ use restitution::data::walton::write_collisions;
 use restitution::data::{CsvOut, fmt_num, write_all_atomic};
 use restitution::experiment::Camera;
 use restitution::kinematics::batch::BatchOptions;
-use restitution::kinematics::{Eq8Inputs, FitKind, G_MAX_M_S2, G_STANDARD_M_S2};
+use restitution::kinematics::{Eq8Inputs, FitKind, G_EXPECTED, G_STANDARD_M_S2, g_ok};
 use restitution::models::walton::K_HOMOGENEOUS;
 use std::path::PathBuf;
 
@@ -85,7 +85,6 @@ const SUBPIXEL_M_RANGE: (f64, f64) = restitution::data::frames::job::PIXEL_M_RAN
 pub fn run(args: Args) -> CliResult {
     let material = args.material.resolve()?;
     for (flag, v) in [
-        ("--g-m-s2", args.g_m_s2),
         ("--s-subpixels", args.s_subpixels),
         ("--fov-m", args.fov_m),
         ("--subpixel-expansion", args.subpixel_expansion),
@@ -95,11 +94,10 @@ pub fn run(args: Args) -> CliResult {
         }
     }
     super::check_inertia_k(args.inertia_k)?;
-    if args.g_m_s2 > G_MAX_M_S2 {
+    if !g_ok(args.g_m_s2) {
         return Err(format!(
-            "--g-m-s2 {}: expected at most {} m/s^2 (1e5 g, a centrifuge's)",
-            fmt_num(args.g_m_s2),
-            fmt_num(G_MAX_M_S2)
+            "--g-m-s2 {}: expected {G_EXPECTED}",
+            fmt_num(args.g_m_s2)
         ));
     }
     if args.pixels_x == 0 {

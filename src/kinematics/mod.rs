@@ -45,6 +45,14 @@ pub const G_STANDARD_M_S2: f64 = 9.80665;
 /// named the first collision's own reason instead of the gravity.
 pub const G_MAX_M_S2: f64 = 1e6;
 
+/// The range of gravities a fixed-gravity fit takes, as an error line states it.
+pub const G_EXPECTED: &str = "a number > 0, at most 1e6 m/s^2 (1e5 g, a centrifuge's)";
+
+/// Whether `g` is a gravity the front ends give a fixed-gravity fit ([`G_EXPECTED`]).
+pub fn g_ok(g: f64) -> bool {
+    g.is_finite() && g > 0.0 && g <= G_MAX_M_S2
+}
+
 /// How each coordinate is fitted in time.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum FitKind {
