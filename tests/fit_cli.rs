@@ -778,3 +778,55 @@ fn a_model_that_made_the_points_is_named_among_exact_fits() {
     assert!(!why.contains("pm,"), "pm cannot make these points: {why}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A correlation is printed only between parameters that carry an error: where both of
+/// `product`'s parameters are bounds (e near 1 at every speed: eta at the bottom of its box,
+/// sigma_y above the speeds' yield), the curvature at the box's edge had given eta~sigma_y
+/// 0.518, a number that looked like a result. On the shipped data both have errors and the
+/// correlation is a number.
+#[test]
+fn correlations_only_between_parameters_with_errors() {
+    let dir = scratch("corr");
+    let f = write(
+        &dir,
+        "elastic.csv",
+        "d_mm,v_n_m_s,e,e_err\n12.7,0.5,1.01,0.02\n12.7,0.8,1.00,0.02\n12.7,1.2,0.99,0.02\n\
+         12.7,2.0,1.02,0.02\n12.7,3.0,0.98,0.02\n",
+    );
+    let json = |file: &str| -> serde_json::Value {
+        let r = run(&[
+            "fit",
+            file,
+            "--material",
+            "nylon",
+            "--model",
+            "product",
+            "--format",
+            "json",
+        ]);
+        assert!(r.ok, "{}", r.stderr);
+        serde_json::from_str(&r.stdout).unwrap()
+    };
+    let v = json(&f);
+    let fit = &v["fits"][0];
+    assert_eq!(fit["params"]["eta"]["status"], "upper_bound", "{fit}");
+    assert_eq!(fit["params"]["sigma_y"]["status"], "lower_bound", "{fit}");
+    for a in ["eta", "sigma_y"] {
+        for b in ["eta", "sigma_y"] {
+            assert!(fit["correlation"][a][b].is_null(), "{a}~{b}: {fit}");
+        }
+    }
+    let r = run(&["fit", &f, "--material", "nylon", "--model", "product"]);
+    assert!(r.ok, "{}", r.stderr);
+    assert!(
+        r.stdout.contains("correlations: product: eta~sigma_y -\n"),
+        "{}",
+        r.stdout
+    );
+    let shipped = json("data/fig7_nylon.csv");
+    let c = shipped["fits"][0]["correlation"]["eta"]["sigma_y"]
+        .as_f64()
+        .expect("a number on the shipped data");
+    assert!(c.abs() < 1.0, "{c}");
+    assert_eq!(shipped["fits"][0]["correlation"]["eta"]["eta"], 1.0);
+}

@@ -81,7 +81,8 @@ pub struct FitResult {
     /// `v_yield_m_s` (V_Y, Eq. 15, of the data's pair geometry when all points share one, as
     /// identical spheres of any sizes do; else of identical spheres).
     pub derived: Vec<ParamEstimate>,
-    /// Correlation matrix of the parameters (NaN where undetermined; reported as null).
+    /// Correlation matrix of the parameters: NaN (reported as null) where undetermined or where
+    /// either parameter has no error (a bound or unconstrained).
     pub correlation: Vec<Vec<f64>>,
     pub n: usize,
     pub dof: usize,

@@ -132,10 +132,20 @@ pub(super) fn summarise(
             ));
         }
     }
+    // Only between parameters that carry an error: for a bound or an unconstrained parameter
+    // the curvature at the search box's edge or on a plateau says nothing about how the two
+    // vary together (both of `product`'s parameters bounds had printed a correlation of 0.518).
+    let has_error = |j: usize| params[j].stderr.is_some();
     let correlation = (0..k)
         .map(|i| {
             (0..k)
-                .map(|j| cov[(i, j)] / (cov[(i, i)] * cov[(j, j)]).sqrt())
+                .map(|j| {
+                    if has_error(i) && has_error(j) {
+                        cov[(i, j)] / (cov[(i, i)] * cov[(j, j)]).sqrt()
+                    } else {
+                        f64::NAN
+                    }
+                })
                 .collect()
         })
         .collect();
