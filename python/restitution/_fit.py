@@ -40,7 +40,8 @@ class FitResult:
     models : list of str
         The fitted models, in the document's order.
     params : dict
-        ``params[model][name]`` is a dict with ``value``, ``stderr`` (scaled by sqrt(chi2/dof)),
+        ``params[model][name]`` is a dict with ``value``, ``stderr`` (scaled by sqrt(s),
+        s = max(1, chi2/dof) with error bars, chi2/dof without),
         ``interval`` (95% profile-likelihood interval, ends None where open), ``unit`` and
         ``status`` ("estimate", or a bound when the data cannot determine the parameter).
     warnings : list of str

@@ -49,7 +49,8 @@ pub struct FitMethodRow {
 #[derive(Debug, Clone, PartialEq)]
 pub struct FitAccuracy {
     pub rows: Vec<FitMethodRow>,
-    /// The reference fit's eta and its standard error (scaled by sqrt(chi2/dof)), kg/(s m).
+    /// The reference fit's eta and its standard error (`stderr`: scaled by sqrt(s),
+    /// s = max(1, chi2/dof), docs/physics.md §7.5), kg/(s m).
     pub eta_ref: f64,
     pub eta_ref_stderr: f64,
     pub reference_fit_ms: f64,
