@@ -71,19 +71,32 @@ class Source:
         self.kwargs = {"name": name, "text": buf.getvalue()}
 
     def relocate(self, err: BaseException) -> BaseException:
-        """An error about line L of the CSV text, reworded to name row L - 2 of the table."""
+        """An error about line L of the CSV text, reworded to name row L - 2 of the table; one
+        about the header line (L = 1) names no row (it is about the table's columns), and the
+        reader's words for a file's header become the table's."""
         line = getattr(err, "line", None)
-        if self.labels is None or not isinstance(err, InputError) or line is None:
+        if self.labels is None or not isinstance(err, InputError):
             return err
-        row = line - 2
-        label = self.labels[row] if 0 <= row < len(self.labels) else row
-        where = f"{getattr(err, 'path', '')}: row {label!r}"
+        detail = str(getattr(err, "detail", err))
+        if line is None:
+            if detail != _NO_HEADER:
+                return err
+            detail, label = "the table has no columns", None
+        else:
+            row = line - 2
+            label = self.labels[row] if 0 <= row < len(self.labels) else None
+        where = f"{getattr(err, 'path', '')}"
+        if label is not None:
+            where += f": row {label!r}"
         col = getattr(err, "column", None)
         if col is not None:
             where += f": column '{col}'"
-        new = InputError(f"{where}: {getattr(err, 'detail', err)}")
-        for a in ("path", "column", "detail", "kind"):
+        for file_words, table_words in _HEADER_WORDS:
+            detail = detail.replace(file_words, table_words)
+        new = InputError(f"{where}: {detail}")
+        for a in ("path", "column", "kind"):
             setattr(new, a, getattr(err, a, None))
+        new.detail = detail
         new.line = line
         new.row = label
         return new
@@ -99,10 +112,21 @@ class Source:
             head, sep, rest = m[len(name) + 1 :].partition(": ")
             if m.startswith(name + ":") and sep and head.isdigit():
                 row = int(head) - 2
-                label = self.labels[row] if 0 <= row < len(self.labels) else row
-                m = f"{name}: row {label!r}: {rest}"
+                if 0 <= row < len(self.labels):
+                    m = f"{name}: row {self.labels[row]!r}: {rest}"
+                else:
+                    m = f"{name}: {rest}"
             out.append(m)
         return out
+
+
+# The CSV reader's words for a file's header line, as a table's (the CSV text of a table is its
+# columns' names, then its rows).
+_NO_HEADER = "no header line (the file is empty)"
+_HEADER_WORDS = (
+    ("no data rows after the header", "the table has no rows"),
+    ("(header has: ", "(the table has: "),
+)
 
 
 def _columns_of(data: Any):

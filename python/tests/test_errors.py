@@ -79,14 +79,43 @@ def test_table_errors_name_the_row():
         {"d_mm": [12.7, 12.7, 12.7], "v_n_m_s": [1.0, 2.0, np.nan], "e": [0.9, 0.9, 0.9]},
         index=["a", "b", "c"],
     )
-    with pytest.raises(rs.InputError, match=r"^<DataFrame>: row 'c': column 'v_n_m_s': '' is not a number$"):
+    with pytest.raises(
+        rs.InputError,
+        match=r"^<DataFrame>: row 'c': column 'v_n_m_s': empty \(a missing value\): a number is required$",
+    ):
         rs.fit(df, "nylon")
+    with pytest.raises(
+        rs.InputError,
+        match=r"^<dict>: row 1: column 'e': empty \(a missing value\): a number is required$",
+    ):
+        rs.fit({"d_mm": [12.7, 12.7], "v_n_m_s": [1, 2], "e": [0.9, None]}, "nylon")
     with pytest.raises(rs.InputError, match=r"^<dict>: row 1: column 'e': '-0.5' is out of range"):
         rs.fit({"d_mm": [12.7, 12.7], "v_n_m_s": [1, 2], "e": [0.9, -0.5]}, "nylon")
     with pytest.raises(rs.InputError, match="different lengths"):
         rs.fit({"d_mm": [12.7], "v_n_m_s": [1, 2], "e": [0.9, 0.9]}, "nylon")
     with pytest.raises(TypeError):
         rs.fit(42, "nylon")
+
+
+def test_table_errors_about_its_columns_name_no_row():
+    # The header line of the table's CSV text is no row of the table: these had said "row -1",
+    # and "header" and "file" where the user gave a table.
+    cases = [
+        (lambda: rs.fit({"d_mm": [12.7], "v_n_m_s": [1]}, "nylon"),
+         "<dict>: column 'e': required column is missing (the table has: d_mm,v_n_m_s)"),
+        (lambda: rs.fit({"d_mm": [], "v_n_m_s": [], "e": []}, "nylon"),
+         "<dict>: the table has no rows"),
+        (lambda: rs.fit({}, "nylon"), "<dict>: the table has no columns"),
+        (lambda: rs.walton_fit({"d1_mm": [25.4]}, "nylon"),
+         "<dict>: column 'd2_mm': required column is missing (the table has: d1_mm)"),
+        (lambda: rs.kinematics({"collision": [], "t_s": []}, "nylon"),
+         "<dict>: the table has no rows"),
+    ]
+    for call, message in cases:
+        with pytest.raises(rs.InputError) as info:
+            call()
+        assert str(info.value) == message
+        assert info.value.row is None
 
 
 @pytest.mark.parametrize(

@@ -16,6 +16,10 @@ use super::{DataError, DataFailure, shown};
 use std::fs;
 use std::path::Path;
 
+/// The message of an empty cell where a number is required (a missing value: an empty field in
+/// a file, NaN or None in a table the Python package writes).
+pub const EMPTY_CELL: &str = "empty (a missing value): a number is required";
+
 /// One data row and the 1-based line it came from; its fields are the table's
 /// ([`Table::field`]).
 #[derive(Debug, Clone)]
@@ -310,12 +314,14 @@ impl Table {
         shown(self.field(row, col))
     }
 
-    /// A finite number from a cell ("inf" and "nan" are rejected).
+    /// A finite number from a cell ("inf" and "nan" are rejected; an empty cell is [`EMPTY_CELL`]).
     pub fn number(&self, row: &Row, col: usize) -> Result<f64, DataError> {
         let raw = self.field(row, col);
         let text = || self.shown(row, col);
         match raw.parse::<f64>() {
             Ok(v) if v.is_finite() => Ok(v),
+            // "'' is not a number" read as if the reader had lost the value.
+            Err(_) if raw.is_empty() => Err(self.cell_error(row, col, EMPTY_CELL)),
             Ok(_) => Err(self.cell_error(row, col, format!("'{}' is not a finite number", text()))),
             Err(_) if raw.contains('\n') => Err(self.cell_error(
                 row,
@@ -390,6 +396,20 @@ mod tests {
         let col = t.require("e").unwrap();
         let err = t.number(&t.rows[1], col).unwrap_err();
         assert_eq!(err.to_string(), "f.csv:7: column 'e': 'x' is not a number");
+    }
+
+    /// An empty cell says so: "'' is not a number" read as if the reader had lost the value.
+    #[test]
+    fn an_empty_cell_is_named_empty() {
+        let t = Table::parse("f.csv", "d_mm,e\n1.0,\n2.0, \n").unwrap();
+        let col = t.require("e").unwrap();
+        for (row, line) in t.rows.iter().zip([2, 3]) {
+            let err = t.number(row, col).unwrap_err();
+            assert_eq!(
+                err.to_string(),
+                format!("f.csv:{line}: column 'e': empty (a missing value): a number is required")
+            );
+        }
     }
 
     #[test]
