@@ -314,7 +314,7 @@ impl Table {
         shown(self.field(row, col))
     }
 
-    /// A finite number from a cell ("inf" and "nan" are rejected; an empty cell is [`EMPTY_CELL`]).
+    /// A finite number from a cell ("inf" and "nan" are rejected; an empty cell is `EMPTY_CELL`).
     pub fn number(&self, row: &Row, col: usize) -> Result<f64, DataError> {
         let raw = self.field(row, col);
         let text = || self.shown(row, col);

@@ -134,7 +134,7 @@ pub(super) fn summarise(
     }
     // Only between parameters that carry an error: for a bound or an unconstrained parameter
     // the curvature at the search box's edge or on a plateau says nothing about how the two
-    // vary together (both of `product`'s parameters bounds had printed a correlation of 0.518).
+    // vary together (with both of `product`'s parameters bounds, 0.518 had been printed).
     let has_error = |j: usize| params[j].stderr.is_some();
     let correlation = (0..k)
         .map(|i| {
