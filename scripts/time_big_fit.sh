@@ -42,3 +42,9 @@ for data in repeated distinct sizes; do
         tail -1 "$dir/err"
     done
 done
+# The same fit on one thread: its CPU against the two-thread run's shows what running on both
+# cores costs beyond the work itself (twenty-sixth session: nothing measurable on a quiet host,
+# about a tenth more CPU while the host was loaded).
+RAYON_NUM_THREADS=1 /usr/bin/time -f "sizes all, one thread: %U s user + %S s system, %e s wall" \
+    "$BIN" fit "$dir/sizes.csv" --material nylon --model all > /dev/null 2> "$dir/err" || true
+tail -1 "$dir/err"

@@ -763,3 +763,43 @@ fn negative_values_are_values() {
         r.stdout
     );
 }
+
+/// A pure number's unit ("1") is not printed after it: "A = 0.039570 1, a = 0.43404 1" read as
+/// six numbers. Units that are units stay.
+#[test]
+fn the_report_prints_no_unit_after_a_pure_number() {
+    let r = run(&[
+        "export",
+        "reports/fit/params.json",
+        "--engine",
+        "constant-e",
+        "--model",
+        "powerlaw",
+        "--v-range",
+        "0.1,5",
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let first = r.stdout.lines().next().unwrap();
+    assert_eq!(
+        first,
+        "export of reports/fit/params.json (model powerlaw): model powerlaw (A = 0.039570, \
+         a = 0.43404, b = 0.44667), contact end overlap"
+    );
+    let r = run(&[
+        "export",
+        "reports/fit/params.json",
+        "--engine",
+        "table",
+        "--model",
+        "min",
+        "--v-range",
+        "0.1,5",
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    assert!(
+        r.stdout
+            .starts_with("export of reports/fit/params.json (model min): model min (eta = 190.55 kg/(s m), sigma_y = 4.0222e7 Pa)"),
+        "{}",
+        r.stdout
+    );
+}

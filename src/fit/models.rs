@@ -36,6 +36,16 @@ pub const POWERLAW_D_REF_MM: f64 = 10.0;
 /// Reference speed of the power law, m/s.
 pub const POWERLAW_V_REF_M_S: f64 = 1.0;
 
+/// A unit as it follows a number in prose: " kg/(s m)", and nothing for a pure number (unit
+/// "1", which after a value read as a second number: "A = 0.039570 1").
+pub fn unit_after(unit: &str) -> String {
+    if unit == "1" {
+        String::new()
+    } else {
+        format!(" {unit}")
+    }
+}
+
 /// A fitted parameter: its key in tables and JSON, its unit, and whether it is fitted as a logarithm.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ParamSpec {

@@ -248,11 +248,7 @@ fn describe(f: &FitResult) -> String {
         .params
         .iter()
         .map(|p| {
-            let unit = if p.unit == "1" {
-                String::new()
-            } else {
-                format!(" {}", p.unit)
-            };
+            let unit = crate::fit::models::unit_after(p.unit);
             let shown = |rel: &str, x: Option<f64>| match x {
                 Some(x) => format!("{} {rel} {}{unit}", p.key, short_value(x)),
                 None => format!("{} not determined", p.key),

@@ -4,6 +4,7 @@
 use super::files::{Summary, sig};
 use crate::data::fmt_num;
 use crate::dem::law::LawKind;
+use crate::fit::models::unit_after;
 use std::fmt::Write as _;
 
 /// The printed report: the laws with their deviations, per-pair constants, the recommendation.
@@ -17,7 +18,7 @@ pub fn report(s: &Summary) -> String {
         .params()
         .iter()
         .zip(&req.curve.params)
-        .map(|(p, x)| format!("{} = {} {}", p.key, sig(*x, 5), p.unit))
+        .map(|(p, x)| format!("{} = {}{}", p.key, sig(*x, 5), unit_after(p.unit)))
         .collect();
     let _ = writeln!(
         o,

@@ -120,11 +120,7 @@ pub(super) fn summarise(
         if (theta[j] - obj.lower[j]).abs() < 1e-6 * span
             || (theta[j] - obj.upper[j]).abs() < 1e-6 * span
         {
-            let unit = if spec.unit == "1" {
-                String::new()
-            } else {
-                format!(" {}", spec.unit)
-            };
+            let unit = crate::fit::models::unit_after(spec.unit);
             notes.push(format!(
                 "{} ended at the edge of its search range ({}{unit})",
                 spec.key,
