@@ -38,6 +38,8 @@ bash scripts/chain_coverage.sh > /dev/null
 # From video frames: a rendered collision tracked (frames in target/, not committed).
 cargo run --release --quiet --example track_demo -- target/frames > /dev/null
 $B track target/frames/shot_7 --fps 1000 --d-mm 12.7 --out reports/track > /dev/null
+# How honest track's spin errors are, over 100 rendered collisions (about 15 s).
+bash scripts/spin_coverage.sh > /dev/null
 
 # Bench: work-precision chart, stability map, fit accuracy, targets (timings vary by machine).
 $B bench --out reports/bench > /dev/null
