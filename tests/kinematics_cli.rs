@@ -246,3 +246,54 @@ fn flags_that_no_collision_survives_are_named() {
     );
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
 }
+
+/// A collision whose spheres still approach after it (here they keep closing at 1 m/s: e = -0.5
+/// by the formula, surfaces that would interpenetrate) is no measurement of e: skipped with a
+/// warning naming it, while a proper one beside it is measured (e = 0.9 exactly: each sphere at
+/// 1 m/s before and 0.9 m/s after; straight tracks, fixed gravity with a negligible g).
+#[test]
+fn a_collision_still_approaching_afterwards_is_skipped() {
+    let d = 0.0127;
+    let mut text = String::from("collision,t_s,x1_m,y1_m,x2_m,y2_m,d1_mm,d2_mm,phase\n");
+    for (id, v_post) in [("good", -0.9), ("closing", 0.5)] {
+        for k in (-6..=6).filter(|&k| k != 0) {
+            let t = f64::from(k) * 1e-3;
+            let (v, phase) = if t < 0.0 {
+                (1.0, "pre")
+            } else {
+                (v_post, "post")
+            };
+            let (x1, x2) = (-d / 2.0 + v * t, d / 2.0 - v * t);
+            text += &format!("{id},{t},{x1},0,{x2},0,12.7,12.7,{phase}\n");
+        }
+    }
+    let dir = std::env::temp_dir().join(format!("restitution-kin-closing-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("tracks.csv");
+    std::fs::write(&path, text).unwrap();
+    let o = Command::new(bin())
+        .args(["kinematics", path.to_str().unwrap(), "--material", "nylon"])
+        .args(["--fixed-gravity", "--g-m-s2", "1e-9", "--format", "csv"])
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    let (out, err) = (
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("skipped") && err.contains("'closing'") && err.contains("after the collision"),
+        "{err}"
+    );
+    let rows: Vec<&str> = out.lines().filter(|l| !l.starts_with('#')).collect();
+    assert_eq!(rows.len(), 2, "{out}");
+    let head: Vec<&str> = rows[0].split(',').collect();
+    let cells: Vec<&str> = rows[1].split(',').collect();
+    let e: f64 = cells[head.iter().position(|c| *c == "e").unwrap()]
+        .parse()
+        .unwrap();
+    // Exact straight tracks: e to the fits' rounding.
+    assert!((e - 0.9).abs() < 1e-9, "{e}");
+    assert_eq!(cells[0], "good");
+}

@@ -236,6 +236,40 @@ fn cli_bad_input_errors_name_the_place() {
         err.contains(&format!(":{data_line}:")) && err.contains("not approaching"),
         "{err}"
     );
+    // Still approaching after the collision (e < 0): the post-collision velocities equal to the
+    // pre-collision ones, e = -1. A mistyped post velocity (1e40) had been averaged into
+    // e = -7e37 with a 95% interval of [1, 1].
+    let approaching: String = {
+        let mut ls: Vec<String> = lines.iter().map(|s| s.to_string()).collect();
+        let mut cells: Vec<String> = ls[header_idx + 1].split(',').map(String::from).collect();
+        for (post, pre) in [
+            ("v1x_post_m_s", "v1x_m_s"),
+            ("v1y_post_m_s", "v1y_m_s"),
+            ("v2x_post_m_s", "v2x_m_s"),
+            ("v2y_post_m_s", "v2y_m_s"),
+        ] {
+            cells[col(post)] = cells[col(pre)].clone();
+        }
+        ls[header_idx + 1] = cells.join(",");
+        ls.join("\n") + "\n"
+    };
+    let path = dir.join("approaching.csv");
+    std::fs::write(&path, approaching).unwrap();
+    let (ok, stdout, err) = run(&[
+        "walton",
+        "fit",
+        path.to_str().unwrap(),
+        "--material",
+        "nylon",
+    ]);
+    assert!(!ok && stdout.is_empty(), "{stdout}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains(&format!(":{data_line}:"))
+            && err.contains("after the collision")
+            && err.contains("e >= 0"),
+        "{err}"
+    );
     // A moving wall.
     let wall = "d1_mm,d2_mm,x1_m,y1_m,x2_m,y2_m,v1x_m_s,v1y_m_s,w1z_rad_s,v2x_m_s,v2y_m_s,w2z_rad_s,v1x_post_m_s,v1y_post_m_s,w1z_post_rad_s,v2x_post_m_s,v2y_post_m_s,w2z_post_rad_s\n\
                 # a comment line, counted\n\

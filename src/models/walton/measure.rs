@@ -40,8 +40,9 @@ pub struct Measured {
 /// post-collision kinematics. The contact geometry (n, and the contact velocity's lever arms) is
 /// taken from `pre`; the post-collision positions are not used.
 ///
-/// Errors: invalid bodies, coincident centres, a wall in one state and a sphere in the other, or
-/// surfaces that were not approaching before (e would be meaningless).
+/// Errors: invalid bodies, coincident centres, a wall in one state and a sphere in the other,
+/// surfaces that were not approaching before (e would be meaningless), or that still approach
+/// after (e < 0).
 pub fn measure(pre: &State, post: &State) -> Result<Measured> {
     let f = pre.contact()?;
     let n = f.normal;
@@ -74,7 +75,18 @@ pub fn measure(pre: &State, post: &State) -> Result<Measured> {
             expected: "< 0 (approaching spheres)",
         });
     }
-    let e = -v_rel_post.dot(&n) / approach;
+    // Still approaching after the collision, the surfaces would interpenetrate: no e < 0 is a
+    // measurement (`fit` refuses one as data). A mistyped post-collision velocity had given
+    // e = -2.5e39, and the Walton fit averaged it into e = -7e37 with a 95% interval of [1, 1].
+    let separation = v_rel_post.dot(&n);
+    if separation.is_nan() || separation < 0.0 {
+        return Err(Error::InvalidParameter {
+            name: "normal relative velocity (v_1' - v_2') . n after the collision (m/s)",
+            value: separation,
+            expected: ">= 0 (separating spheres: e >= 0)",
+        });
+    }
+    let e = -separation / approach;
     let v_c_post = v_rel_post - half_d_w_post.cross(&n);
     let v_s_post = v_c_post - v_c_post.dot(&n) * n;
     let vs2 = f.v_s_m_s.norm_squared();

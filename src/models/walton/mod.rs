@@ -492,4 +492,27 @@ mod tests {
         let coincident = State::on_wall(b1, b1.position_m);
         assert!(coincident.contact().is_err());
     }
+
+    /// The inverse operator measures only separating surfaces: a sphere that drops onto a wall at
+    /// 2 m/s and leaves at rest has e = 0 exactly; one still falling afterwards (at 1 m/s: e = -0.5
+    /// by the formula) is an error, not a coefficient of restitution.
+    #[test]
+    fn measure_refuses_surfaces_still_approaching() {
+        let s = Sphere::new(0.02, crate::contact::Material::preset("nylon").unwrap()).unwrap();
+        let at = Vector3::new(0.0, 0.01, 0.0);
+        let falling = |vy: f64| {
+            State::on_wall(
+                Body::homogeneous(at, &s).moving(Vector3::new(0.0, vy, 0.0), Vector3::zeros()),
+                Vector3::zeros(),
+            )
+        };
+        let pre = falling(-2.0);
+        assert_eq!(measure(&pre, &falling(0.0)).unwrap().e, 0.0);
+        assert_eq!(measure(&pre, &falling(1.0)).unwrap().e, 0.5);
+        let err = measure(&pre, &falling(-1.0)).unwrap_err().to_string();
+        assert!(
+            err.contains("after the collision") && err.contains("e >= 0"),
+            "{err}"
+        );
+    }
 }
