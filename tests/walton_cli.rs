@@ -270,6 +270,30 @@ fn cli_bad_input_errors_name_the_place() {
             && err.contains("e >= 0"),
         "{err}"
     );
+    // A mistyped post-collision velocity that still separates the spheres (-1e40 m/s): the fit
+    // runs, but a warning names the row whose momentum is not conserved.
+    let path = dir.join("typo.csv");
+    std::fs::write(&path, with_cell("v1x_post_m_s", "-1e40")).unwrap();
+    let (ok, _, err) = run(&[
+        "walton",
+        "fit",
+        path.to_str().unwrap(),
+        "--material",
+        "nylon",
+    ]);
+    assert!(ok, "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.starts_with("restitution: warning: ")
+            && err.contains(&format!(":{data_line}: collision '1':"))
+            && err.contains("momentum is not conserved"),
+        "{err}"
+    );
+    let (ok, _, err) = run(&["walton", "fit", &shipped(), "--material", "nylon"]);
+    assert!(
+        ok && err.is_empty(),
+        "the shipped data warn of nothing: {err}"
+    );
     // A moving wall.
     let wall = "d1_mm,d2_mm,x1_m,y1_m,x2_m,y2_m,v1x_m_s,v1y_m_s,w1z_rad_s,v2x_m_s,v2y_m_s,w2z_rad_s,v1x_post_m_s,v1y_post_m_s,w1z_post_rad_s,v2x_post_m_s,v2y_post_m_s,w2z_post_rad_s\n\
                 # a comment line, counted\n\

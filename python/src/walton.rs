@@ -6,7 +6,7 @@ use crate::{Failure, Outcome, Source, run_detached};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use restitution::data::report::walton::{Context, to_json};
-use restitution::data::walton::{measure_records, read_collisions};
+use restitution::data::walton::{measure_records, momentum_warning, read_collisions};
 use restitution::fit::walton::{self as wfit, FitOptions, Weights};
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -60,8 +60,9 @@ fn walton_fit<'py>(
             ));
         }
         let table = source?.table()?;
-        let (records, warnings) = read_collisions(&table, &material, inertia_k)?;
+        let (records, mut warnings) = read_collisions(&table, &material, inertia_k)?;
         let measured = measure_records(&table.path, &records)?;
+        warnings.extend(momentum_warning(&table.path, &records, &measured));
         let options = FitOptions {
             inertia_k,
             weights,

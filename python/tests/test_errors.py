@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import restitution as rs
-from conftest import cli_error, run_cli
+from conftest import DATA, cli_error, run_cli
 
 
 def write(tmp_path, name, text):
@@ -242,3 +242,20 @@ def test_huge_speeds_give_an_error_not_a_panic():
     # Once a panic (capacity overflow in the fit's old scan), on the command line too.
     with pytest.raises(ValueError):
         rs.fit({"d_mm": [12.7] * 3, "v_n_m_s": [1, 2, 1e300], "e": [0.9, 0.8, 0.7]}, "nylon", model="pm")
+
+
+def test_a_walton_row_that_breaks_momentum_is_named(tmp_path, monkeypatch):
+    # The shipped collisions with one post-collision velocity mistyped (-1e40 m/s): the fit runs,
+    # and the warning the CLI prints names the row, here as in the command line.
+    monkeypatch.chdir(tmp_path)
+    lines = (DATA / "oblique_collisions.csv").read_text().splitlines()
+    head = next(i for i, l in enumerate(lines) if not l.startswith("#"))
+    cols = lines[head].split(",")
+    cells = lines[head + 1].split(",")
+    cells[cols.index("v1x_post_m_s")] = "-1e40"
+    lines[head + 1] = ",".join(cells)
+    write(tmp_path, "typo.csv", "\n".join(lines) + "\n")
+    r = rs.walton_fit("typo.csv", "nylon", bootstrap=0)
+    [w] = r.warnings
+    assert w.startswith(f"typo.csv:{head + 2}: collision '1': ") and "momentum is not conserved" in w
+    assert rs.walton_fit(DATA / "oblique_collisions.csv", "nylon", bootstrap=0).warnings == []

@@ -239,6 +239,40 @@ pub fn measure_records(
         .collect()
 }
 
+/// One warning for the collisions whose centre of mass changes velocity by more than the
+/// collision's own speed (|v_c| before: v_n and |v_s| combined), naming the first by its line and
+/// counting the others; None when there are none (walls have no such check). Measured velocities
+/// conserve momentum to their noise (the Fig. 6 data: 0.06 m/s at 4 m/s), so a change as large
+/// as the speed itself is a mistyped velocity: one at 1e40 m/s had been fitted into e = 7e37,
+/// with nothing naming the row. `measured` is `records` measured ([`measure_records`]).
+pub fn momentum_warning(
+    path: &str,
+    records: &[CollisionRecord],
+    measured: &[Measured],
+) -> Option<String> {
+    let mut off = records.iter().zip(measured).filter_map(|(r, m)| {
+        let dv = m.com_velocity_change_m_s?.norm();
+        let speed = m.v_n_m_s.hypot(m.v_s_m_s);
+        (dv > speed).then_some((r, dv, speed))
+    });
+    let (r, dv, speed) = off.next()?;
+    let more = off.count();
+    let id = r.id.as_deref().map_or(String::new(), |id| {
+        format!(" collision '{}':", super::shown(id))
+    });
+    Some(format!(
+        "{path}:{}:{id} the centre of mass's velocity changes by {} m/s, more than the collision's speed {} m/s: momentum is not conserved (a mistyped velocity?){}",
+        r.line,
+        fmt_num(dv),
+        fmt_num(speed),
+        if more > 0 {
+            format!(" (and {more} more collisions like it)")
+        } else {
+            String::new()
+        }
+    ))
+}
+
 /// Writes records in the `walton fit` CSV schema: the in-plane columns, plus the out-of-plane
 /// ones when any record has a nonzero z component, position or in-plane spin. A `collision` id
 /// column is written when any record has an id. Numbers in shortest round-trip form.

@@ -31,7 +31,7 @@ use render::{fig6_fit, fig6_points};
 use restitution::data::report::walton::{
     Context, render_collisions_csv, render_markdown, render_params_csv, render_table, to_json,
 };
-use restitution::data::walton::{measure_records, read_collisions};
+use restitution::data::walton::{measure_records, momentum_warning, read_collisions};
 use restitution::data::{Table, write_all_atomic};
 use restitution::fit::walton::{self as wfit, FitOptions, Weights};
 use restitution::models::walton::K_HOMOGENEOUS;
@@ -138,6 +138,9 @@ fn run_fit(a: FitArgs) -> CliResult {
         ));
     }
     let measured = measure_records(&table.path, &records).map_err(|e| e.to_string())?;
+    if let Some(w) = momentum_warning(&table.path, &records, &measured) {
+        super::warn(w);
+    }
     let options = FitOptions {
         inertia_k: a.inertia_k,
         weights: match a.weights {
