@@ -297,3 +297,24 @@ fn a_collision_still_approaching_afterwards_is_skipped() {
     assert!((e - 0.9).abs() < 1e-9, "{e}");
     assert_eq!(cells[0], "good");
 }
+
+/// The table's fixed-decimals columns switch to exponent form for large values: an absurd
+/// `--s-subpixels 1e300` (Eq. 8's claimed centre accuracy) had printed e_eq8 with 300 digits.
+#[test]
+fn huge_values_print_in_exponent_form() {
+    let (ok, out, err) = kinematics_with("huge-s", &["--s-subpixels", "1e300"]);
+    assert!(ok, "{err}");
+    let rows: Vec<&str> = out
+        .lines()
+        .skip(1)
+        .take_while(|l| !l.starts_with('('))
+        .collect();
+    assert!(!rows.is_empty(), "{out}");
+    for row in rows {
+        let e_eq8 = row.split_whitespace().nth(4).unwrap();
+        assert!(
+            e_eq8.len() <= 10 && e_eq8.contains("e29"),
+            "{e_eq8} in {row}"
+        );
+    }
+}

@@ -274,7 +274,7 @@ fn cli_bad_input_errors_name_the_place() {
     // runs, but a warning names the row whose momentum is not conserved.
     let path = dir.join("typo.csv");
     std::fs::write(&path, with_cell("v1x_post_m_s", "-1e40")).unwrap();
-    let (ok, _, err) = run(&[
+    let (ok, stdout, err) = run(&[
         "walton",
         "fit",
         path.to_str().unwrap(),
@@ -282,6 +282,15 @@ fn cli_bad_input_errors_name_the_place() {
         "nylon",
     ]);
     assert!(ok, "{err}");
+    // Its absurd numbers in exponent form (fixed decimals had printed 40-digit values).
+    let spread = stdout
+        .lines()
+        .find(|l| l.starts_with("e over the collisions"))
+        .unwrap();
+    assert!(
+        spread.contains("e38") && spread.split_whitespace().all(|t| t.len() <= 12),
+        "{spread}"
+    );
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     assert!(
         err.starts_with("restitution: warning: ")

@@ -24,7 +24,7 @@ use restitution::data::report::kinematics::{
 };
 use restitution::data::tracks::read_tracks;
 use restitution::data::walton::write_collisions;
-use restitution::data::{CsvOut, fmt_num, write_all_atomic};
+use restitution::data::{CsvOut, fixed, fmt_num, write_all_atomic};
 use restitution::experiment::Camera;
 use restitution::kinematics::batch::BatchOptions;
 use restitution::kinematics::{Eq8Inputs, FitKind, G_EXPECTED, G_STANDARD_M_S2, g_ok};
@@ -257,22 +257,20 @@ pub fn run(args: Args) -> CliResult {
                 let me = &r.m.measured;
                 let dv = me.com_velocity_change_m_s.unwrap_or_default();
                 s += &format!(
-                    "{:>10} {:>7.3} {:>9.4} {:>8.4} {:>8.4} {:>8} {:>8} {:>7.3} {:>7.3} {:>5}/{:<5} {}\n",
+                    "{:>10} {:>7} {:>9} {:>8} {:>8} {:>8} {:>8} {:>7} {:>7} {:>5}/{:<5} {}\n",
                     r.id,
-                    me.v_n_m_s,
-                    me.e,
-                    r.m.e_err,
-                    r.m.e_err_eq8,
-                    me.beta
-                        .map(|b| format!("{b:.3}"))
-                        .unwrap_or_else(|| "-".into()),
+                    fixed(me.v_n_m_s, 3),
+                    fixed(me.e, 4),
+                    fixed(r.m.e_err, 4),
+                    fixed(r.m.e_err_eq8, 4),
+                    me.beta.map_or_else(|| "-".into(), |b| fixed(b, 3)),
                     if me.psi.is_finite() {
-                        format!("{:.3}", me.psi)
+                        fixed(me.psi, 3)
                     } else {
                         "-".into()
                     },
-                    dv.x,
-                    dv.y,
+                    fixed(dv.x, 3),
+                    fixed(dv.y, 3),
                     r.m.kinematics.n_pre,
                     r.m.kinematics.n_post,
                     r.m.kinematics.time_rule.name()

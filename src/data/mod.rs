@@ -109,6 +109,17 @@ pub fn fmt_num(x: f64) -> String {
     crate::error::Num(x).to_string()
 }
 
+/// A number in a table's fixed-decimals column: `decimals` decimals, or exponent form (four
+/// significant digits) from 1e7 on, where fixed decimals would print up to 300 digits (an absurd
+/// `--s-subpixels 1e300` had made `kinematics` print a 300-digit e_eq8).
+pub fn fixed(x: f64, decimals: usize) -> String {
+    if x.is_finite() && x.abs() >= 1e7 {
+        format!("{x:.3e}")
+    } else {
+        format!("{x:.decimals$}")
+    }
+}
+
 /// A number for human eyes: 10 significant digits, exponent form when very small or large.
 pub fn readable(x: f64) -> String {
     let a = x.abs();
@@ -130,6 +141,16 @@ pub fn readable(x: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fixed_decimals_until_the_digits_run_away() {
+        assert_eq!(fixed(0.89484, 4), "0.8948");
+        assert_eq!(fixed(-1.5, 3), "-1.500");
+        assert_eq!(fixed(9_999_999.0, 1), "9999999.0");
+        assert_eq!(fixed(1e7, 1), "1.000e7");
+        assert_eq!(fixed(-5.841417919e300, 4), "-5.841e300");
+        assert_eq!(fixed(f64::NAN, 3), "NaN");
+    }
 
     #[test]
     fn shortest_round_trip() {

@@ -1,7 +1,7 @@
 //! The documents of `restitution walton fit` (and of Python's `walton_fit`): the table, the
 //! parameters CSV, the per-collision CSV, JSON and Markdown, built once for both front ends.
 
-use crate::data::{CsvOut, fmt_num};
+use crate::data::{CsvOut, fixed, fmt_num};
 use crate::fit::walton::{self as wfit, Bound, Estimate, WaltonFit};
 use crate::models::walton::Target;
 use serde_json::{Value, json};
@@ -59,11 +59,7 @@ fn pm(value: f64, err: Option<f64>) -> (String, String, usize) {
     match err {
         Some(se) if se.is_finite() && se > 0.0 => {
             let decimals = (1 - se.log10().floor() as i32).clamp(0, 12) as usize;
-            (
-                format!("{value:.decimals$}"),
-                format!("{se:.decimals$}"),
-                decimals,
-            )
+            (fixed(value, decimals), fixed(se, decimals), decimals)
         }
         _ => (crate::data::readable(value), "-".into(), 4),
     }
@@ -71,7 +67,7 @@ fn pm(value: f64, err: Option<f64>) -> (String, String, usize) {
 
 fn interval(ci: Option<(f64, f64)>, decimals: usize) -> String {
     match ci {
-        Some((lo, hi)) => format!("[{lo:.decimals$}, {hi:.decimals$}]"),
+        Some((lo, hi)) => format!("[{}, {}]", fixed(lo, decimals), fixed(hi, decimals)),
         None => "-".into(),
     }
 }
@@ -125,8 +121,10 @@ pub fn render_table(fit: &WaltonFit, ctx: &Context) -> String {
         );
     }
     s += &format!(
-        "\ne over the collisions: spread (sd) {:.3}, range {:.3} .. {:.3}\n",
-        fit.e.spread, fit.e.min, fit.e.max
+        "\ne over the collisions: spread (sd) {}, range {} .. {}\n",
+        fixed(fit.e.spread, 3),
+        fixed(fit.e.min, 3),
+        fixed(fit.e.max, 3)
     );
     if fit.converged {
         s += &format!(
@@ -146,13 +144,13 @@ pub fn render_table(fit: &WaltonFit, ctx: &Context) -> String {
     }
     if let Some(rms) = fit.com_dv_rms_m_s {
         s += &format!(
-            "momentum check: rms change of the centre-of-mass velocity {:.3} m/s (0 for exact data)\n",
-            rms
+            "momentum check: rms change of the centre-of-mass velocity {} m/s (0 for exact data)\n",
+            fixed(rms, 3)
         );
     }
     s += &format!(
-        "residuals: rms {:.3} in beta, {} degrees of freedom; bootstrap {} resamples (seed {}, {} left out)\n",
-        fit.residual_rms,
+        "residuals: rms {} in beta, {} degrees of freedom; bootstrap {} resamples (seed {}, {} left out)\n",
+        fixed(fit.residual_rms, 3),
         fit.dof,
         fit.bootstrap.resamples,
         fit.bootstrap.seed,
@@ -378,8 +376,10 @@ pub fn render_markdown(fit: &WaltonFit, ctx: &Context) -> String {
         s += &format!("| {name} | {v} | {se} | {} |\n", interval(est.ci95, dec));
     }
     s += &format!(
-        "\n- e over the collisions: spread (sd) {:.3}, range {:.3} to {:.3}.\n",
-        fit.e.spread, fit.e.min, fit.e.max
+        "\n- e over the collisions: spread (sd) {}, range {} to {}.\n",
+        fixed(fit.e.spread, 3),
+        fixed(fit.e.min, 3),
+        fixed(fit.e.max, 3)
     );
     s += &format!(
         "- Classes: {} sliding, {} rolling, {} head-on.\n",
@@ -400,12 +400,13 @@ pub fn render_markdown(fit: &WaltonFit, ctx: &Context) -> String {
     }
     if let Some(rms) = fit.com_dv_rms_m_s {
         s += &format!(
-            "- Momentum check: rms change of the centre-of-mass velocity {rms:.3} m/s (0 for exact data).\n"
+            "- Momentum check: rms change of the centre-of-mass velocity {} m/s (0 for exact data).\n",
+            fixed(rms, 3)
         );
     }
     s += &format!(
-        "- Residual rms {:.3} in beta, {} degrees of freedom; bootstrap {} resamples, seed {}, {} left out.\n",
-        fit.residual_rms,
+        "- Residual rms {} in beta, {} degrees of freedom; bootstrap {} resamples, seed {}, {} left out.\n",
+        fixed(fit.residual_rms, 3),
         fit.dof,
         fit.bootstrap.resamples,
         fit.bootstrap.seed,
