@@ -830,3 +830,42 @@ fn correlations_only_between_parameters_with_errors() {
     assert!(c.abs() < 1.0, "{c}");
     assert_eq!(shipped["fits"][0]["correlation"]["eta"]["eta"], 1.0);
 }
+
+/// Fig. 7's legend with unequal pairs and a wall: the models' column starts past the longest
+/// data label ("data, 6.35 mm on 25.4 mm" had run into the first model's line sample at x = 260)
+/// and says a curve is drawn per pair, not per size.
+#[test]
+fn the_figure_legend_makes_room_for_pair_labels() {
+    let dir = scratch("legend");
+    let mut text = String::from("d_mm,d2_mm,v_n_m_s,e,e_err\n");
+    for (k, v) in [0.5, 1.0, 2.0, 4.0].iter().enumerate() {
+        let e = 0.95 - 0.01 * f64::from(k as u32);
+        text += &format!("6.35,25.4,{v},{e},0.01\n12.7,inf,{v},{},0.01\n", e + 0.01);
+    }
+    let f = write(&dir, "pairs.csv", &text);
+    let out = dir.join("out");
+    let r = run(&[
+        "fit",
+        &f,
+        "--material",
+        "nylon",
+        "--model",
+        "vm",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let svg = std::fs::read_to_string(out.join("fig7.svg")).unwrap();
+    let at = svg
+        .find("VM, one per pair: eta")
+        .expect("the VM legend entry");
+    let tag = &svg[svg[..at].rfind("<text x=\"").unwrap() + 9..];
+    let x: i32 = tag[..tag.find('"').unwrap()].parse().unwrap();
+    // Its line sample (40 px before the text) starts past the longest data label: text from
+    // x = 80, 24 characters of up to 8 px at this font size (the old column started at 260).
+    assert!(
+        x - 40 >= 80 + 24 * 8,
+        "the VM entry's sample starts at x = {}",
+        x - 40
+    );
+}

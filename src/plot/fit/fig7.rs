@@ -95,11 +95,13 @@ fn draw_fig7(
         .enumerate()
         .map(|(gi, (_, label))| (Sample::Marker(gi, colour(gi)), format!("data, {label}")))
         .collect();
-    // A curve per size only where the sizes are drawn apart.
+    // A curve per size (identical spheres) or pair only where they are drawn apart.
     let per_size = if merged {
         "curves left out"
-    } else {
+    } else if drawn.iter().all(|(g, _)| g.d2_mm.is_none()) {
         "one per size"
+    } else {
+        "one per pair"
     };
     let mut legend: Vec<(Sample, String)> = Vec::new();
     let combined = preferred
@@ -213,7 +215,11 @@ fn draw_fig7(
             draw_error_bars(&mut chart, bars, c.stroke_width(1), 6)?;
             draw_markers(&mut chart, &shown[gi], gi, 4, c)?;
         }
-        draw_legend(&bottom, &[(40, data_key), (260, legend)], 16)?;
+        // The models' column starts past the longest data label (about half the font size per
+        // character as drawn): "data, 6.35 mm on 25.4 mm" had run into its first line sample.
+        let longest = data_key.iter().map(|(_, t)| t.chars().count()).max();
+        let models_x = (80 + 8 * longest.unwrap_or(0) as i32 + 20).max(260);
+        draw_legend(&bottom, &[(40, data_key), (models_x, legend)], 16)?;
         root.present().map_err(svg_err)?;
     }
     Ok(buf)
