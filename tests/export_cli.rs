@@ -803,3 +803,32 @@ fn the_report_prints_no_unit_after_a_pure_number() {
         r.stdout
     );
 }
+
+/// A params.json of one model (`fit --model min --out`: no comparison, so nothing preferred)
+/// exports that model without --model, and the report's first line names it.
+#[test]
+fn a_file_of_one_fit_exports_it() {
+    let dir = scratch("one-fit");
+    let d = dir.to_string_lossy().to_string();
+    let r = run(&[
+        "fit",
+        "data/fig7_nylon.csv",
+        "--material",
+        "nylon",
+        "--model",
+        "min",
+        "--out",
+        &d,
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let params = format!("{d}/params.json");
+    let r = run(&["export", &params, "--engine", "table", "--v-range", "0.5,5"]);
+    assert!(r.ok, "{}", r.stderr);
+    assert!(
+        r.stdout.lines().next().unwrap().starts_with(&format!(
+            "export of {params} (model min): model min (eta = "
+        )),
+        "{}",
+        r.stdout
+    );
+}

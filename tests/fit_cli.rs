@@ -726,6 +726,12 @@ fn exact_fits_are_not_ranked_by_aic() {
     ]);
     assert!(!r.ok);
     assert_eq!(r.stderr.trim_end().lines().count(), 1, "{}", r.stderr);
+    assert!(
+        r.stderr
+            .contains("(it has: vm, pm, min, product): choose one with --model"),
+        "{}",
+        r.stderr
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -131,7 +131,7 @@ def export(
         velocity-independent e per pair (LAMMPS damping tsuji, LIGGGHTS); "table": e(v_n) per
         pair for event-driven codes (`table_points` speeds).
     model : str, optional
-        The model to export (default: the fit's preferred one).
+        The model to export (default: the fit's preferred one, or its only model).
     walton : path, WaltonResult or dict, optional
         mu_0 and beta_0 from ``restitution walton fit``; or give `mu0` (and `beta0`).
     d_mm : float or sequence, optional

@@ -11,8 +11,8 @@
 //!     [--model vm|pm|min|product] [--eta ETA] [--sigma-y-pa S] [--contact-end overlap|force]
 //! ```
 //! PARAMS.json is what `restitution fit --out` writes (material, contact end, the fitted models;
-//! the preferred one unless --model); WALTON.json what `restitution walton fit --out` writes
-//! (mu_0, beta_0). `--d-mm` sets the scene's sphere sizes (one engine type each; default: the fit
+//! the preferred one, or the only one, unless --model); WALTON.json what `restitution walton
+//! fit --out` writes (mu_0, beta_0). `--d-mm` sets the scene's sphere sizes (one engine type each; default: the fit
 //! data's spheres, both of each pair, with a wall if the data hit one), `--wall` adds sphere-wall
 //! contacts. Engines:
 //! - `lammps`: DIR/in.restitution (`pair_style granular` and every `pair_coeff`), DIR/collide.in;
@@ -72,7 +72,7 @@ pub struct Args {
     params: Option<PathBuf>,
     #[arg(long, value_enum)]
     engine: Engine,
-    /// Model to export (default: the file's preferred model)
+    /// Model to export (default: the file's preferred model, or its only one)
     #[arg(long, value_name = "NAME")]
     model: Option<String>,
     /// walton.json written by `restitution walton fit --out` (mu_0, beta_0)

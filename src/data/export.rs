@@ -249,18 +249,26 @@ fn params_from_value(p: String, v: Value) -> Result<FitParamsFile, DataError> {
 }
 
 impl FitParamsFile {
-    /// The fitted curve of `model` (the file's preferred model when `None`). Errors: an unknown
-    /// or absent model, a parameter missing or only bounded (no value to export).
+    /// The fitted curve of `model` (when `None`: the file's preferred model, or its only fit,
+    /// as `fit --model min --out` writes, which has no comparison to prefer one; the report's
+    /// first line names the model exported). Errors: an unknown or absent model, a parameter
+    /// missing or only bounded (no value to export).
     pub fn curve(&self, model: Option<&str>) -> Result<(FittedCurve, &FitEntry), DataError> {
-        let name = match model {
-            Some(m) => m.to_string(),
-            None => self.preferred.clone().ok_or_else(|| {
-                err(
+        let name = match (model, &self.preferred, &self.fits[..]) {
+            (Some(m), ..) => m.to_string(),
+            (None, Some(p), _) => p.clone(),
+            (None, None, [only]) => only.model.clone(),
+            (None, None, fits) => {
+                let have: Vec<&str> = fits.iter().map(|f| f.model.as_str()).collect();
+                return Err(err(
                     &self.path,
                     DataFailure::Schema,
-                    "no 'preferred' model in the file: choose one with --model",
-                )
-            })?,
+                    format!(
+                        "no 'preferred' model in the file (it has: {}): choose one with --model",
+                        have.join(", ")
+                    ),
+                ));
+            }
         };
         let kind: ModelKind = name
             .parse()
