@@ -12,9 +12,9 @@
 //! ```
 //! PARAMS.json is what `restitution fit --out` writes (material, contact end, the fitted models;
 //! the preferred one, or the only one, unless --model); WALTON.json what `restitution walton
-//! fit --out` writes (mu_0, beta_0). `--d-mm` sets the scene's sphere sizes (one engine type each; default: the fit
-//! data's spheres, both of each pair, with a wall if the data hit one), `--wall` adds sphere-wall
-//! contacts. Engines:
+//! fit --out` writes (mu_0, beta_0). `--d-mm` sets the scene's sphere sizes (one engine type
+//! each; default: the fit data's spheres, both of each pair, with a wall if the data hit one),
+//! `--wall` adds sphere-wall contacts. Engines:
 //! - `lammps`: DIR/in.restitution (`pair_style granular` and every `pair_coeff`), DIR/collide.in;
 //!   exact for `vm`, otherwise the closest viscoelastic law or constant e over --v-range
 //!   (`--law`, default the closer one);
