@@ -166,6 +166,19 @@ fn published_constants() {
     // Hertz contact time as kappa -> 0 (dimensionless): 3.2180654597190430845.
     let r = rebound(1e-12, ContactEnd::Overlap, &OdeSettings::DEFAULT).unwrap();
     assert!((r.tau_contact - 3.2180654597190430845).abs() < 1e-10);
+    // The force rule down to the smallest kappa: its end, where x = -kappa p, sits within
+    // rounding of the overlap's, and the event locator had run out of iterations from about
+    // kappa = 1e-100 (`predict --contact-end force --kappa 1e-100` failed). Same Hertz limit,
+    // to the integration's 1e-10 as above.
+    for kappa in [1e-100, 1e-300, 5e-324] {
+        let r = rebound(kappa, ContactEnd::Force, &OdeSettings::DEFAULT).unwrap();
+        assert!(
+            (r.tau_contact - 3.2180654597190430845).abs() < 1e-10,
+            "{kappa}: {}",
+            r.tau_contact
+        );
+        assert_eq!(r.e, 1.0, "{kappa}");
+    }
     // Large kappa, overlap rule: e kappa^5 -> 5.15838170426768 (fixture, mpmath).
     let e100 = viscoelastic::restitution(100.0, ContactEnd::Overlap, &VmMethod::Master)
         .unwrap()

@@ -98,6 +98,12 @@ pub(super) fn locate(
     };
     let mut evals = 0;
     let mut side = 0i8;
+    // The bracket is resolved once it is rounding-small against its own first width: near the
+    // force-rule end in the root variable s (x = s^2) the root sits at s ~ (kappa e)^(1/2), and
+    // Newton on g = s^2 + kappa p only halves s there, so a floor relative to s itself (or to
+    // 1e-300) took ~170 halvings for kappa = 1e-100 and ran out of iterations; a point within
+    // 4 eps of the first width changes x, p and the time below their rounding.
+    let width0 = (b.s1 - b.s0).abs();
     // A converged point must be a root of the probed trajectory, not just the end of a collapsed
     // bracket: the bracket's ends come from accepted steps, and a re-integration that does not
     // reproduce the sign change (a coarse setting) would otherwise collapse onto a point where g
@@ -126,7 +132,7 @@ pub(super) fn locate(
         }
     };
     for _ in 0..LOCATE_MAX_ITERATIONS {
-        if best.2 == 0.0 || (c - a).abs() <= 4.0 * f64::EPSILON * c.abs().max(a.abs()).max(1e-300) {
+        if best.2 == 0.0 || (c - a).abs() <= 4.0 * f64::EPSILON * c.abs().max(a.abs()).max(width0) {
             return finish(best, evals);
         }
         let inside = |s: f64| s.is_finite() && (s - a) * (s - c) < 0.0;
