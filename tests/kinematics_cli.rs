@@ -17,8 +17,8 @@ fn tracks() -> String {
     .unwrap()
 }
 
-/// Runs `kinematics` on `text` (CSV output) and returns (stdout, stderr).
-fn kinematics(tag: &str, text: &str) -> (String, String) {
+/// Runs `kinematics` on `text` (CSV output) with `flags` and returns (stdout, stderr).
+fn kinematics(tag: &str, text: &str, flags: &[&str]) -> (String, String) {
     let dir = std::env::temp_dir().join(format!("restitution-kin-{tag}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("tracks.csv");
@@ -26,6 +26,7 @@ fn kinematics(tag: &str, text: &str) -> (String, String) {
     let o = Command::new(bin())
         .args(["kinematics", path.to_str().unwrap(), "--material", "nylon"])
         .args(["--format", "csv"])
+        .args(flags)
         .output()
         .unwrap();
     let _ = std::fs::remove_dir_all(&dir);
@@ -60,9 +61,9 @@ fn beta(csv: &str) -> String {
 #[test]
 fn an_unmeasured_spin_is_named_not_silently_zero() {
     let full = tracks();
-    let (out_full, err_full) = kinematics("full", &full);
+    let (out_full, err_full) = kinematics("full", &full, &[]);
     assert!(!err_full.contains("not measured"), "{err_full}");
-    let (out_blank, err_blank) = kinematics("blank", &blank(&full, "w2z_post_rad_s"));
+    let (out_blank, err_blank) = kinematics("blank", &blank(&full, "w2z_post_rad_s"), &[]);
     assert!(
         err_blank.contains("collision 'shot_7': w2z_post_rad_s not measured (empty): taken as 0"),
         "{err_blank}"
@@ -267,21 +268,7 @@ fn a_collision_still_approaching_afterwards_is_skipped() {
             text += &format!("{id},{t},{x1},0,{x2},0,12.7,12.7,{phase}\n");
         }
     }
-    let dir = std::env::temp_dir().join(format!("restitution-kin-closing-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("tracks.csv");
-    std::fs::write(&path, text).unwrap();
-    let o = Command::new(bin())
-        .args(["kinematics", path.to_str().unwrap(), "--material", "nylon"])
-        .args(["--fixed-gravity", "--g-m-s2", "1e-9", "--format", "csv"])
-        .output()
-        .unwrap();
-    let _ = std::fs::remove_dir_all(&dir);
-    let (out, err) = (
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr),
-    );
-    assert!(o.status.success(), "{err}");
+    let (out, err) = kinematics("closing", &text, &["--fixed-gravity", "--g-m-s2", "1e-9"]);
     assert!(
         err.contains("skipped") && err.contains("'closing'") && err.contains("after the collision"),
         "{err}"

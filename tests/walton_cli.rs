@@ -133,14 +133,15 @@ fn cli_bad_input_errors_name_the_place() {
     let header_idx = lines.iter().position(|l| !l.starts_with('#')).unwrap();
     let header: Vec<&str> = lines[header_idx].split(',').collect();
     let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
-    // Replace one cell of the first data row (file line header_idx + 2).
-    let with_cell = |name: &str, value: &str| {
+    // The file with the first data row's cells (file line header_idx + 2) edited by `edit`.
+    let with_row = |edit: &dyn Fn(&mut Vec<String>)| {
         let mut ls: Vec<String> = lines.iter().map(|s| s.to_string()).collect();
         let mut cells: Vec<String> = ls[header_idx + 1].split(',').map(String::from).collect();
-        cells[col(name)] = value.into();
+        edit(&mut cells);
         ls[header_idx + 1] = cells.join(",");
         ls.join("\n") + "\n"
     };
+    let with_cell = |name: &str, value: &str| with_row(&|cells| cells[col(name)] = value.into());
     let data_line = header_idx + 2;
     let cases: Vec<(&str, String, Vec<String>)> = vec![
         (
@@ -212,16 +213,12 @@ fn cli_bad_input_errors_name_the_place() {
         }
     }
     // Receding spheres: swap the pre- and post-collision columns' meaning by reversing velocities.
-    let receding: String = {
-        let mut ls: Vec<String> = lines.iter().map(|s| s.to_string()).collect();
-        let mut cells: Vec<String> = ls[header_idx + 1].split(',').map(String::from).collect();
+    let receding = with_row(&|cells| {
         for c in ["v1x_m_s", "v1y_m_s", "v2x_m_s", "v2y_m_s"] {
             let v: f64 = cells[col(c)].parse().unwrap();
             cells[col(c)] = format!("{}", -v);
         }
-        ls[header_idx + 1] = cells.join(",");
-        ls.join("\n") + "\n"
-    };
+    });
     let path = dir.join("receding.csv");
     std::fs::write(&path, receding).unwrap();
     let (ok, _, err) = run(&[
@@ -239,9 +236,7 @@ fn cli_bad_input_errors_name_the_place() {
     // Still approaching after the collision (e < 0): the post-collision velocities equal to the
     // pre-collision ones, e = -1. A mistyped post velocity (1e40) had been averaged into
     // e = -7e37 with a 95% interval of [1, 1].
-    let approaching: String = {
-        let mut ls: Vec<String> = lines.iter().map(|s| s.to_string()).collect();
-        let mut cells: Vec<String> = ls[header_idx + 1].split(',').map(String::from).collect();
+    let approaching = with_row(&|cells| {
         for (post, pre) in [
             ("v1x_post_m_s", "v1x_m_s"),
             ("v1y_post_m_s", "v1y_m_s"),
@@ -250,9 +245,7 @@ fn cli_bad_input_errors_name_the_place() {
         ] {
             cells[col(post)] = cells[col(pre)].clone();
         }
-        ls[header_idx + 1] = cells.join(",");
-        ls.join("\n") + "\n"
-    };
+    });
     let path = dir.join("approaching.csv");
     std::fs::write(&path, approaching).unwrap();
     let (ok, stdout, err) = run(&[
