@@ -173,6 +173,37 @@ fn the_files_say_how_many_collisions_were_skipped() {
             "{f}: {first}"
         );
     }
+    // So does every format on stdout: a table or document kept in a file loses the warnings.
+    let printed = |format: &str| {
+        let o = Command::new(bin())
+            .args(["kinematics", path.to_str().unwrap(), "--material", "nylon"])
+            .args(["--format", format])
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8(o.stdout).unwrap()
+    };
+    let table = printed("table");
+    assert!(
+        table.contains("(1 of 2 collisions skipped: they cannot be measured"),
+        "{table}"
+    );
+    let csv = printed("csv");
+    assert_eq!(
+        csv,
+        std::fs::read_to_string(out.join("kinematics.csv")).unwrap()
+    );
+    let doc: serde_json::Value = serde_json::from_str(&printed("json")).unwrap();
+    assert_eq!(doc["collisions"].as_array().unwrap().len(), 1);
+    assert_eq!(doc["collisions"][0]["collision"], "shot_7");
+    let skipped = doc["skipped"].as_array().unwrap();
+    assert_eq!(skipped.len(), 1);
+    let why = skipped[0].as_str().unwrap();
+    assert!(
+        why.contains("collision 'short'") && why.contains("frames"),
+        "{why}"
+    );
+    assert_eq!(doc["unmeasured_spins"], serde_json::json!([]));
     let _ = std::fs::remove_dir_all(&dir);
 }
 

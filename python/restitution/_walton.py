@@ -153,11 +153,12 @@ class KinematicsResult:
     """The outcome of :func:`kinematics`: one row per measured collision.
 
     ``to_dict()`` is exactly the document of ``restitution kinematics --format json`` (built by
-    the same library function): a list with one record per collision whose keys are the
-    ``kinematics.csv`` columns. ``columns()`` gives the same numbers by column, with the CLI's
-    single ``v_err_m_s`` (the rms of the eight velocity errors) split into the eight errors
-    ``v1x_err_m_s`` ... ``v2y_post_err_m_s``, and None for a momentum check a collision does
-    not have (the CLI's 0).
+    the same library function): ``collisions``, a list with one record per collision whose keys
+    are the ``kinematics.csv`` columns, and ``skipped`` and ``unmeasured_spins`` as below.
+    ``columns()`` gives the same numbers by column, with the CLI's single ``v_err_m_s`` (the rms
+    of the eight velocity errors) split into the eight errors ``v1x_err_m_s`` ...
+    ``v2y_post_err_m_s``, and None for a momentum check a collision does not have (the CLI's
+    null, an empty cell in CSV).
 
     Attributes
     ----------
@@ -183,8 +184,9 @@ class KinematicsResult:
         for line in self.unmeasured_spins:
             warnings.warn(line, UserWarning, stacklevel=3)
 
-    def to_dict(self) -> List[Dict[str, Any]]:
-        """The ``restitution kinematics --format json`` document (a list of records)."""
+    def to_dict(self) -> Dict[str, Any]:
+        """The ``restitution kinematics --format json`` document: ``collisions`` (a list of
+        records), ``skipped`` and ``unmeasured_spins``."""
         return copy.deepcopy(self._doc)
 
     def columns(self) -> Dict[str, List[Any]]:
@@ -208,7 +210,7 @@ class KinematicsResult:
         }
 
     def __repr__(self) -> str:
-        n = len(self._doc)
+        n = len(self._doc["collisions"])
         return f"<KinematicsResult: {n} collisions, {len(self.skipped)} skipped>"
 
 

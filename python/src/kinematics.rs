@@ -134,7 +134,7 @@ fn kinematics<'py>(
         if let Some(why) = measured.refusal(&table.path, strict) {
             return Err(Failure::Input(why));
         }
-        let json = kinematics_json(&measured.rows);
+        let json = kinematics_json(&measured);
         Ok(Done {
             measured,
             subpixel_m,

@@ -156,22 +156,26 @@ def test_walton_numbers_equal_cli_json(in_root):
     assert w.params["mu0"]["value"] == cli["mu0"]["value"]
 
 
-@pytest.mark.parametrize("case, extra", [("normal", ["--fixed-gravity"]), ("oblique", [])])
-def test_kinematics_columns_equal_cli_json(in_root, case, extra):
+# The normal collisions without --fixed-gravity: 23 of 150 have two frames on a side, too few
+# for free quadratics, and are skipped (the document lists them).
+@pytest.mark.parametrize(
+    "case, extra, n_skipped", [("normal", ["--fixed-gravity"], 0), ("oblique", [], 0), ("normal", [], 23)]
+)
+def test_kinematics_columns_equal_cli_json(in_root, case, extra, n_skipped):
     path = f"data/virtual/{case}/tracks.csv"
-    rows = cli_json("kinematics", path, "--material", "nylon", *extra)
+    doc = cli_json("kinematics", path, "--material", "nylon", *extra)
     result = rs.kinematics(path, "nylon", fixed_gravity=bool(extra))
     # The same document, bit for bit (both are the library's kinematics_json).
-    assert result.to_dict() == rows
+    assert result.to_dict() == doc
+    assert doc["skipped"] == result.skipped and len(result.skipped) == n_skipped
+    assert all("frames per phase = 2" in why for why in result.skipped)
+    rows = doc["collisions"]
     cols = result.columns()
     shared = [k for k in rows[0] if k in cols]
     # The only CLI column not given as such: v_err_m_s, the rms of the eight velocity errors.
     assert set(rows[0]) - set(shared) == {"v_err_m_s"}
     for k in shared:
-        got = cols[k]
-        if k.startswith("momentum_"):
-            got = [0.0 if x is None else x for x in got]  # the CLI writes 0 for "none"
-        assert list(got) == [r[k] for r in rows], k
+        assert list(cols[k]) == [r[k] for r in rows], k
     # The eight errors give the CLI's rms. Tolerance 1e-15 relative: numpy sums the eight
     # squares in another order than the CLI (each of the 8 additions and the square root rounds
     # once, 1.1e-16 each), so only the last bits may differ.

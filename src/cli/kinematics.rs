@@ -159,6 +159,7 @@ pub fn run(args: Args) -> CliResult {
     if let Some(why) = measured.refusal(&shown, args.strict) {
         return Err(why);
     }
+    let json = kinematics_json(&measured);
     let Measured {
         rows,
         records,
@@ -236,8 +237,10 @@ pub fn run(args: Args) -> CliResult {
         .map_err(|e| format!("{}: cannot write: {e}", dir.display()))?;
     }
     let text = match args.format {
-        Format::Csv => kinematics_csv(&rows, None),
-        Format::Json => kinematics_json(&rows),
+        // The same document as the --out directory's kinematics.csv, its comment included
+        // (what made it, and how many collisions were skipped).
+        Format::Csv => kinematics_csv(&rows, Some(&comment)),
+        Format::Json => json,
         Format::Table => {
             let mut s = format!(
                 "{:>10} {:>7} {:>9} {:>8} {:>8} {:>8} {:>8} {:>7} {:>7} {:>5}/{:<5} time\n",
@@ -255,7 +258,10 @@ pub fn run(args: Args) -> CliResult {
             );
             for r in &rows {
                 let me = &r.m.measured;
-                let dv = me.com_velocity_change_m_s.unwrap_or_default();
+                let dv = |k: usize| {
+                    me.com_velocity_change_m_s
+                        .map_or("-".into(), |v| fixed(v[k], 3))
+                };
                 s += &format!(
                     "{:>10} {:>7} {:>9} {:>8} {:>8} {:>8} {:>8} {:>7} {:>7} {:>5}/{:<5} {}\n",
                     r.id,
@@ -269,8 +275,8 @@ pub fn run(args: Args) -> CliResult {
                     } else {
                         "-".into()
                     },
-                    fixed(dv.x, 3),
-                    fixed(dv.y, 3),
+                    dv(0),
+                    dv(1),
                     r.m.kinematics.n_pre,
                     r.m.kinematics.n_post,
                     r.m.kinematics.time_rule.name()
@@ -291,6 +297,14 @@ pub fn run(args: Args) -> CliResult {
                 fmt_num(args.s_subpixels),
                 fmt_num(subpixel_m)
             );
+            // A table kept in a file loses the warnings on stderr: it says what it leaves out.
+            if !skipped.is_empty() {
+                s += &format!(
+                    "({} of {} collisions skipped: they cannot be measured; the warnings say why)\n",
+                    skipped.len(),
+                    rows.len() + skipped.len()
+                );
+            }
             s
         }
     };

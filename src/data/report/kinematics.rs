@@ -58,7 +58,6 @@ impl Row {
             .map(|v| v.norm_squared())
             .sum::<f64>()
             / 8.0;
-        let dv = me.com_velocity_change_m_s.unwrap_or_default();
         let mut c = vec![
             self.id.clone(),
             fmt_num(k.t_c_s),
@@ -89,8 +88,11 @@ impl Row {
         } else {
             String::new()
         });
-        c.push(fmt_num(dv.x));
-        c.push(fmt_num(dv.y));
+        // No momentum check (a wall has no second momentum): empty, not a 0 that reads as a
+        // perfect check.
+        let dv = me.com_velocity_change_m_s;
+        c.push(dv.map(|v| fmt_num(v.x)).unwrap_or_default());
+        c.push(dv.map(|v| fmt_num(v.y)).unwrap_or_default());
         c.push(fmt_num(self.d1_mm));
         c.push(fmt_num(self.d2_mm));
         c
@@ -127,10 +129,17 @@ pub fn fit_input_csv(rows: &[Row], comment: &str) -> String {
     out.into_string()
 }
 
-/// The JSON document: one record per collision with the CSV's columns as keys (numbers as
-/// numbers, empty cells as null, the id and the time rule as strings).
-pub fn kinematics_json(rows: &[Row]) -> String {
-    let list: Vec<serde_json::Value> = rows
+/// The JSON document: `collisions`, one record per measured collision with the CSV's columns
+/// as keys (numbers as numbers, empty cells as null, the id and the time rule as strings); and
+/// what a reader of those records must also know, as the command's warnings say it: `skipped`,
+/// the collisions that could not be measured (often the fast ones, so the records span a
+/// narrower range of speeds than was filmed), and `unmeasured_spins`, the collisions whose
+/// empty spin cells were taken as 0 in beta and psi. (A bare list of records, as before, left
+/// both out: a program reading it could not tell a campaign measured whole from one with
+/// collisions missing.)
+pub fn kinematics_json(m: &Measured) -> String {
+    let list: Vec<serde_json::Value> = m
+        .rows
         .iter()
         .map(|r| {
             let map: serde_json::Map<String, serde_json::Value> = COLUMNS
@@ -148,7 +157,12 @@ pub fn kinematics_json(rows: &[Row]) -> String {
             serde_json::Value::Object(map)
         })
         .collect();
-    serde_json::to_string_pretty(&list).expect("JSON values serialise") + "\n"
+    let doc = serde_json::json!({
+        "collisions": list,
+        "skipped": m.skipped,
+        "unmeasured_spins": m.unmeasured_spins,
+    });
+    serde_json::to_string_pretty(&doc).expect("JSON values serialise") + "\n"
 }
 
 /// The whole `kinematics` pass over a tracks file, as the command line and Python run it: every
@@ -264,5 +278,47 @@ pub fn measure_tracks(shown: &str, tracks: &[CollisionTrack], options: &BatchOpt
         skipped: skipped.into_iter().map(|(_, s)| s).collect(),
         unmeasured_spins,
         fits_meet,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::contact::Material;
+    use crate::kinematics::{Eq8Inputs, FitKind};
+
+    #[test]
+    fn a_missing_momentum_check_is_empty_not_zero() {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/data/virtual/normal/tracks.csv"
+        );
+        let tracks = crate::data::tracks::read_tracks(std::path::Path::new(path)).unwrap();
+        let options = BatchOptions {
+            material: Material::preset("nylon").unwrap(),
+            inertia_k: 0.4,
+            kind: FitKind::FixedGravity {
+                g_m_s2: crate::kinematics::G_STANDARD_M_S2,
+            },
+            eq8: Eq8Inputs {
+                s_subpixels: 2.0,
+                subpixel_m: 6.25e-5,
+            },
+        };
+        let mut m = measure_tracks("tracks.csv", &tracks, &options);
+        assert!(m.skipped.is_empty(), "{:?}", m.skipped);
+        let col = |name: &str| COLUMNS.iter().position(|c| *c == name).unwrap();
+        let (x, y) = (col("momentum_dvx_m_s"), col("momentum_dvy_m_s"));
+        // A pair has its check (measured, so not exactly 0)...
+        let cells = m.rows[0].cells();
+        assert!(cells[x].parse::<f64>().unwrap() != 0.0, "{}", cells[x]);
+        // ...a collision without one (a wall's) shows an empty cell and a JSON null, never a 0
+        // that reads as a perfect check.
+        m.rows[0].m.measured.com_velocity_change_m_s = None;
+        let cells = m.rows[0].cells();
+        assert_eq!((cells[x].as_str(), cells[y].as_str()), ("", ""));
+        let doc: serde_json::Value = serde_json::from_str(&kinematics_json(&m)).unwrap();
+        assert!(doc["collisions"][0]["momentum_dvx_m_s"].is_null(), "{doc}");
+        assert!(doc["collisions"][0]["e"].is_number(), "{doc}");
     }
 }
