@@ -303,8 +303,15 @@ impl FitParamsFile {
                     DataFailure::Value,
                     format!(
                         "model '{name}': parameter '{}' has no value (status {status}: the data \
-                         do not determine it); export another model or give it as a flag",
-                        spec.key
+                         do not determine it); export another model{}, or give the law as numbers \
+                         without the fit (its model, parameters and material)",
+                        spec.key,
+                        limit_model(kind, spec.key, status)
+                            .filter(|m| self.fits.iter().any(|f| f.model == *m))
+                            .map_or(String::new(), |m| format!(
+                                " (the fit tends to '{m}' as {} grows without bound)",
+                                spec.key
+                            ))
                     ),
                 )
             })?;
@@ -319,6 +326,14 @@ impl FitParamsFile {
         })?;
         Ok((curve, entry))
     }
+}
+
+/// The one-parameter model that `kind` becomes as parameter `key`, bounded only from below
+/// (`status` lower_bound), grows without bound: with sigma_y -> inf no point yields (e_pm = 1),
+/// so `min` and `product` are `vm`; with eta -> inf e_vm -> 0, which leaves nothing to export.
+fn limit_model(kind: ModelKind, key: &str, status: &str) -> Option<&'static str> {
+    let two = matches!(kind, ModelKind::Min | ModelKind::Product);
+    (two && key == "sigma_y" && status == "lower_bound").then_some("vm")
 }
 
 /// Reads e, beta_0 and mu_0 from a walton.json (see [`WaltonParams`]).
