@@ -2,7 +2,7 @@
 //! post-collision kinematics (docs/physics.md §4); the round trip with [`super::collide`] is
 //! tested in the parent module.
 
-use super::{State, Target};
+use super::{State, Target, length};
 use crate::error::{Error, Result};
 use nalgebra::Vector3;
 
@@ -91,7 +91,7 @@ pub fn measure(pre: &State, post: &State) -> Result<Measured> {
     let v_s_post = v_c_post - v_c_post.dot(&n) * n;
     let vs2 = f.v_s_m_s.norm_squared();
     let v_n = -f.v_n_signed_m_s;
-    let head_on = f.v_s_m_s.norm() <= 1e-12 * v_n.abs();
+    let head_on = length(&f.v_s_m_s) <= 1e-12 * v_n.abs();
     let beta = if head_on {
         None
     } else {
@@ -105,21 +105,28 @@ pub fn measure(pre: &State, post: &State) -> Result<Measured> {
         (Target::Sphere(a), Target::Sphere(b)) => {
             let m2 = a.mass_kg;
             let dp2 = -m2 * (b.velocity_m_s - a.velocity_m_s);
-            // Var(m_i Delta v_i) ~ m_i^2 when both spheres' velocities carry the same error.
+            // Var(m_i Delta v_i) ~ m_i^2 when both spheres' velocities carry the same error: weights
+            // 1/m_i^2. Where those underflow (heavy bodies, density 1e300 kg/m^3: the mean was
+            // 0/0) or overflow, the same mean with the mass ratio alone.
             let (w1, w2) = (1.0 / (m1 * m1), 1.0 / (m2 * m2));
-            let dp = (w1 * dp1 + w2 * dp2) / (w1 + w2);
+            let dp = if w1.is_normal() && w2.is_normal() {
+                (w1 * dp1 + w2 * dp2) / (w1 + w2)
+            } else {
+                let r2 = (m1 / m2).powi(2);
+                (dp1 + r2 * dp2) / (1.0 + r2)
+            };
             (dp, Some((dp1 - dp2) / (m1 + m2)))
         }
         _ => (dp1, None),
     };
     let dp_n = impulse.dot(&n);
-    let dp_t = (impulse - dp_n * n).norm();
+    let dp_t = length(&(impulse - dp_n * n));
     Ok(Measured {
         e,
         beta,
         psi,
         v_n_m_s: v_n,
-        v_s_m_s: f.v_s_m_s.norm(),
+        v_s_m_s: length(&f.v_s_m_s),
         impulse_n_s: impulse,
         impulse_normal_n_s: dp_n.abs(),
         impulse_tangential_n_s: dp_t,
