@@ -875,3 +875,103 @@ fn the_figure_legend_makes_room_for_pair_labels() {
         x - 40
     );
 }
+
+/// The x coordinates of the figure's coloured thick dashes (the preferred combined model's
+/// curves; the legend's sample is grey) and of its data markers.
+fn curve_and_marker_xs(svg: &str) -> (Vec<i32>, Vec<i32>) {
+    let xs_of = |points: &str| -> Vec<i32> {
+        points
+            .split_whitespace()
+            .map(|p| p.split(',').next().unwrap().parse().unwrap())
+            .collect()
+    };
+    let mut curve = Vec::new();
+    let mut markers = Vec::new();
+    for line in svg.lines() {
+        if line.contains("<polyline")
+            && line.contains("stroke-width=\"4\"")
+            && !line.contains("#5A5A5A")
+        {
+            let p = &line[line.find("points=\"").unwrap() + 8..];
+            curve.extend(xs_of(&p[..p.find('"').unwrap()]));
+        }
+        if line.starts_with("<circle cx=\"") && line.contains("r=\"4\"") {
+            let num = |key: &str| -> i32 {
+                let p = &line[line.find(key).unwrap() + key.len()..];
+                p[..p.find('"').unwrap()].parse().unwrap()
+            };
+            // The chart is the upper 640 pixels; the legend's markers are below.
+            if num(" cy=\"") < 640 {
+                markers.push(num("<circle cx=\""));
+            }
+        }
+    }
+    (curve, markers)
+}
+
+#[test]
+fn a_curve_with_an_undetermined_parameter_spans_only_the_data() {
+    let dir = scratch("undetermined");
+    // One speed at three sizes: the power law fits them (A (d/10 mm)^(-a) v^b), but A and b are
+    // determined only together, and the curve's slope in v came from b at the search box's edge
+    // (e rising steeply with v through the points). Now not drawn, and the legend says why.
+    let one = write(
+        &dir,
+        "one_speed.csv",
+        "d_mm,v_n_m_s,e,e_err\n6.35,2,0.95,0.01\n12.7,2,0.93,0.01\n25.4,2,0.91,0.01\n6.35,2,0.94,0.01\n",
+    );
+    // One size at many speeds: A and a are determined only together; the curve is drawn over
+    // the data's speeds (1 to 105 m/s), not across the padded axis.
+    let mut text = String::from("d_mm,v_n_m_s,e,e_err\n");
+    for k in 0..15 {
+        let v = 1.4f64.powi(k);
+        let wiggle = if k % 2 == 0 { 0.004 } else { -0.004 };
+        text += &format!("12.7,{v},{},0.005\n", 1.0 - 0.05 * v.powf(0.3) + wiggle);
+    }
+    let many = write(&dir, "one_size.csv", &text);
+    for (f, note) in [
+        (
+            &one,
+            "powerlaw not drawn: a parameter is not determined, and the data have one speed",
+        ),
+        (
+            &many,
+            "powerlaw over the data&apos;s speeds only: a parameter is not determined",
+        ),
+    ] {
+        let out = dir.join(format!("out-{}", f.len()));
+        let r = run(&[
+            "fit",
+            f,
+            "--material",
+            "nylon",
+            "--model",
+            "all",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(r.ok, "{}", r.stderr);
+        let params = std::fs::read_to_string(out.join("params.json")).unwrap();
+        let doc: serde_json::Value = serde_json::from_str(&params).unwrap();
+        assert_eq!(doc["preferred"], "powerlaw", "{f}");
+        let svg = std::fs::read_to_string(out.join("fig7.svg")).unwrap();
+        assert!(svg.contains(note), "{f}: no '{note}'");
+        let (curve, markers) = curve_and_marker_xs(&svg);
+        if f == &one {
+            assert!(curve.is_empty(), "{curve:?}");
+        } else {
+            // From the first marker's x to the last's: within a pixel at the start, where the
+            // first dash begins; within one dash and gap (6 + 5 px) at the end, where the dash
+            // pattern may stop short. Across the padded axis it ran from x = 91 to 965.
+            let (lo, hi) = (
+                *markers.iter().min().unwrap(),
+                *markers.iter().max().unwrap(),
+            );
+            let (clo, chi) = (*curve.iter().min().unwrap(), *curve.iter().max().unwrap());
+            assert!(
+                (clo - lo).abs() <= 1 && chi <= hi && hi - chi <= 11,
+                "curve {clo}..{chi}, data {lo}..{hi}"
+            );
+        }
+    }
+}

@@ -8,14 +8,18 @@ use super::{
 use crate::fit::dataset::{FitData, Group};
 use crate::fit::engine::FitSet;
 use crate::fit::models::{ModelKind, predict_e};
-use crate::fit::result::FitResult;
+use crate::fit::result::{FitResult, ParamStatus};
 use crate::models::viscoelastic::{ContactEnd, VmMethod};
 use crate::plot::{PlotError, PlotFailure, log_axis};
 use plotters::coord::Shift;
 use plotters::coord::combinators::{LogCoord, WithKeyPoints};
 use plotters::prelude::*;
 
-/// The model's e along `vs` for a group's pair, dropping points the axes cannot show.
+/// The model's e along `vs` for a group's pair, dropping points the axes cannot show. Where a
+/// parameter of the fit is not determined (its value is wherever the minimiser stopped on a
+/// plateau), only the data's own speeds pin the curve: it is drawn across the group's speeds
+/// alone (none where they are one speed). One speed at three sizes had shown the power law
+/// preferred with e rising steeply with v, from its b at the edge of the search box.
 fn curve(
     f: &FitResult,
     g: &Group,
@@ -27,14 +31,65 @@ fn curve(
 ) -> Vec<(f64, f64)> {
     let contact = data.contacts[g.indices[0]];
     let p = f.best_fit_values();
-    vs.iter()
-        .filter_map(|&v| {
+    let along: Vec<f64> = match pinned_span(f, g, data) {
+        None => vs.to_vec(),
+        Some((lo, hi)) if hi > lo => std::iter::once(lo)
+            .chain(vs.iter().copied().filter(|v| *v > lo && *v < hi))
+            .chain(std::iter::once(hi))
+            .collect(),
+        Some(_) => Vec::new(),
+    };
+    along
+        .into_iter()
+        .filter_map(|v| {
             predict_e(f.model, &contact, v, &p, rule, method)
                 .ok()
                 .filter(|e| *e >= y_range.0 && *e <= y_range.1)
                 .map(|e| (v, e))
         })
         .collect()
+}
+
+/// The group's range of speeds where a parameter of `f` is not determined (see [`curve`]).
+fn pinned_span(f: &FitResult, g: &Group, data: &FitData) -> Option<(f64, f64)> {
+    undetermined(f).then(|| {
+        g.indices
+            .iter()
+            .map(|&i| data.obs[i].v_n_m_s)
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+                (lo.min(v), hi.max(v))
+            })
+    })
+}
+
+fn undetermined(f: &FitResult) -> bool {
+    f.params
+        .iter()
+        .any(|p| p.status == ParamStatus::Unconstrained)
+}
+
+/// The legend's row under a model drawn over the data's speeds only (see [`curve`]), if it is.
+fn span_note(
+    f: &FitResult,
+    name: &str,
+    groups: &[&Group],
+    data: &FitData,
+    merged: bool,
+) -> Option<(Sample, String)> {
+    if merged || !undetermined(f) {
+        return None;
+    }
+    let one_speed = groups
+        .iter()
+        .all(|g| pinned_span(f, g, data).is_some_and(|(lo, hi)| hi <= lo));
+    Some((
+        Sample::Text,
+        if one_speed {
+            format!("{name} not drawn: a parameter is not determined, and the data have one speed")
+        } else {
+            format!("{name} over the data's speeds only: a parameter is not determined")
+        },
+    ))
 }
 
 /// `fig7.svg`: e against v_n on log-log axes. Data with error bars, one colour and marker per
@@ -112,6 +167,7 @@ fn draw_fig7(
             Sample::Line(RGBColor(90, 90, 90), 2),
             format!("VM{}, {per_size}: {}", tag(ModelKind::Vm), describe(f)),
         ));
+        legend.extend(span_note(f, "VM", &groups, data, merged));
     }
     if let Some(f) = find(ModelKind::Pm) {
         legend.push((
@@ -123,6 +179,7 @@ fn draw_fig7(
                 describe(f)
             ),
         ));
+        legend.extend(span_note(f, "PM", &groups, data, merged));
     }
     if let Some(f) = combined {
         legend.push((
@@ -133,6 +190,7 @@ fn draw_fig7(
                 describe(f)
             ),
         ));
+        legend.extend(span_note(f, f.model.name(), &groups, data, merged));
     }
     // Each group's points, one per pixel, and whether they are drawn as a density (points.rs):
     // the chart's pixels do not depend on the legend's height below it, so a scratch chart of
