@@ -14,6 +14,9 @@ DEFAULT_TOL: float = _ext.DEFAULT_TOL
 
 
 def _flat(x: ArrayLike, name: str) -> Tuple[NDArray[np.float64], Tuple[int, ...]]:
+    # A complex value would be cast to its real part with only a numpy warning.
+    if np.iscomplexobj(x):
+        raise InputError(f"{name}: expected real numbers, got complex values")
     try:
         a = np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError) as err:

@@ -135,6 +135,9 @@ def test_table_errors_about_its_columns_name_no_row():
         (lambda: rs.predict("xx", [1.0]), "model 'xx': expected vm or pm"),
         (lambda: rs.predict("vm", [1.0], kappa=[1.0]), "give exactly one of v_m_s, kappa (vm) or u (pm)"),
         (lambda: rs.e_of_kappa("abc"), None),
+        # numpy would keep the real part with only a ComplexWarning.
+        (lambda: rs.e_of_kappa([0.1, 1 + 1j]), "kappa: expected real numbers, got complex values"),
+        (lambda: rs.predict("vm", np.array([2j]), d_mm=10, material="nylon", eta=1), "v_m_s: expected real numbers, got complex values"),
         (lambda: rs.fit("x.csv", "nylon", model="cubic"), "model 'cubic': expected vm, pm, min, product, powerlaw or all"),
         (lambda: rs.walton_fit("x.csv", "nylon", bootstrap=1), "bootstrap = 1: expected 0 (no intervals) or at least 2 resamples"),
         (lambda: rs.kinematics("x.csv", "nylon", pixels_x=0), "pixels_x = 0: expected a pixel count > 0"),
