@@ -122,19 +122,26 @@ pub fn fixed(x: f64, decimals: usize) -> String {
 
 /// A number for human eyes: 10 significant digits, exponent form when very small or large.
 pub fn readable(x: f64) -> String {
+    significant(x, 10)
+}
+
+/// `x` to `digits` significant digits (at least 1), trailing zeros dropped; exponent form
+/// outside [1e-3, 1e7).
+pub fn significant(x: f64, digits: usize) -> String {
     let a = x.abs();
+    let digits = digits.max(1);
     if x == 0.0 || !x.is_finite() {
         format!("{x}")
     } else if (1e-3..1e7).contains(&a) {
-        let digits = (9 - a.log10().floor() as i32).max(0) as usize;
-        let s = format!("{x:.digits$}");
+        let decimals = (digits as i32 - 1 - a.log10().floor() as i32).max(0) as usize;
+        let s = format!("{x:.decimals$}");
         if s.contains('.') {
             s.trim_end_matches('0').trim_end_matches('.').to_string()
         } else {
             s
         }
     } else {
-        format!("{x:.9e}")
+        format!("{x:.*e}", digits - 1)
     }
 }
 

@@ -197,21 +197,11 @@ pub fn liggghts_input(
     s
 }
 
-/// A speed in the round trip's table: six significant digits, trailing zeros dropped (the
-/// default middle speed, the range's geometric mean, had printed as 4.47213595499958 across the
-/// next column; collide.in and export.json keep every digit).
+/// A speed in the round trip's table: six significant digits (the default middle speed, the
+/// range's geometric mean, had printed as 4.47213595499958 across the next column; collide.in
+/// and export.json keep every digit).
 fn speed(v_m_s: f64) -> String {
-    let a = v_m_s.abs();
-    if !(1e-4..1e7).contains(&a) {
-        return format!("{v_m_s:.5e}");
-    }
-    let decimals = (5 - a.log10().floor() as i32).max(0) as usize;
-    let s = format!("{v_m_s:.decimals$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    } else {
-        s
-    }
+    crate::data::significant(v_m_s, 6)
 }
 
 /// The printed comparison of LAMMPS with the toolkit.
@@ -410,5 +400,6 @@ mod tests {
         assert_eq!(speed(20f64.sqrt()), "4.47214");
         assert_eq!(speed(123_456.7), "123457");
         assert_eq!(speed(1e-5), "1.00000e-5");
+        assert_eq!(speed(0.25), "0.25");
     }
 }
