@@ -379,7 +379,17 @@ pub fn fit(measured: &[Measured], options: &FitOptions) -> Result<WaltonFit> {
     } else {
         String::new()
     };
+    // Walton's operator takes beta_0 in [-1, 1] (above 1 a collision gains energy, docs/physics.md
+    // §4.4). A plateau level outside it is the noise of tangential velocities too small to
+    // measure (nearly head-on collisions: 10 of them at incidence 0 gave beta0 = 1.11 +- 0.55,
+    // "converged"), not a property of the spheres.
+    let outside = hinge.shape != HingeShape::NoRolling && !(-1.0..=1.0).contains(&hinge.beta0);
     let message = match hinge.shape {
+        _ if outside => format!(
+            "not determined: the rolling plateau's level, beta0 = {}, lies outside Walton's range [-1, 1] (above 1 a collision gains energy); its betas scatter by {} (rms residual): the tangential velocities are mostly noise at these angles of incidence",
+            crate::error::Num(hinge.beta0),
+            crate::error::Num(residual_rms)
+        ),
         HingeShape::Both => format!("converged{thin_note}{failed_note}"),
         HingeShape::NoRolling => format!(
             "not determined: no collision reached the rolling plateau, so beta0 >= {} is only a lower bound (mu0 is determined); add collisions closer to head-on (larger psi)",
@@ -459,7 +469,7 @@ pub fn fit(measured: &[Measured], options: &FitOptions) -> Result<WaltonFit> {
             seed: options.seed,
             failed,
         },
-        converged: both,
+        converged: both && !outside,
         message,
         options: *options,
     })
