@@ -23,8 +23,73 @@ pub struct Fig6Fit {
     pub beta0_ci95: Option<(f64, f64)>,
     pub mu0: f64,
     pub e: f64,
-    /// False when the fit did not determine both branches (the legend says so).
-    pub converged: bool,
+    /// Why the fit is not determined, for the legend (None: converged).
+    pub not_determined: Option<&'static str>,
+}
+
+/// The corner of the plot where the legend covers the fewest points, the hinge's line counting a
+/// tenth of a point per sample (the lower right unless another covers fewer), and how many
+/// points it covers there. Its size: `rows`
+/// entries of 25 px and 10 px per character of the longest label `chars`, plus the sample and
+/// margins, on the plot's 785 x 490 px. Ten near-head-on collisions had one of their points
+/// under the legend, fixed in the lower right, where the plateau's noise scattered below -1.
+fn legend_corner(
+    points: &[Fig6Point],
+    hinge: &[(f64, f64); 3],
+    (x_max, y_min, y_max): (f64, f64, f64),
+    (rows, chars): (usize, usize),
+) -> (SeriesLabelPosition, usize) {
+    let w = ((10 * chars + 80) as f64 / 785.0).min(1.0) * x_max;
+    let h = legend_height(rows) * (y_max - y_min);
+    let line = hinge.windows(2).flat_map(|s| {
+        (0..=20).map(move |k| {
+            let t = f64::from(k) / 20.0;
+            (
+                s[0].0 + t * (s[1].0 - s[0].0),
+                s[0].1 + t * (s[1].1 - s[0].1),
+            )
+        })
+    });
+    // (points hidden, line samples hidden)
+    let cost = |right: bool, upper: bool| {
+        let inside = |(x, y): (f64, f64)| {
+            let xs = if right { x >= x_max - w } else { x <= w };
+            let ys = if upper {
+                y >= y_max - h
+            } else {
+                y <= y_min + h
+            };
+            xs && ys && x <= x_max
+        };
+        let hidden = points.iter().filter(|p| inside((p.psi, p.beta))).count();
+        (hidden, line.clone().filter(|&p| inside(p)).count())
+    };
+    let score = |(points, samples): (usize, usize)| points as f64 + 0.1 * samples as f64;
+    [
+        (SeriesLabelPosition::LowerRight, true, false),
+        (SeriesLabelPosition::UpperLeft, false, true),
+        (SeriesLabelPosition::LowerLeft, false, false),
+        (SeriesLabelPosition::UpperRight, true, true),
+    ]
+    .into_iter()
+    .map(|(pos, right, upper)| (pos, cost(right, upper)))
+    .fold(
+        None::<(SeriesLabelPosition, (usize, usize))>,
+        |best, (pos, c)| match best {
+            Some((_, b)) if score(b) <= score(c) => best,
+            _ => Some((pos, c)),
+        },
+    )
+    .map_or(
+        (SeriesLabelPosition::LowerRight, 0),
+        |(pos, (points, _))| (pos, points),
+    )
+}
+
+/// The legend's height with `rows` entries, as a fraction of the plot's (25 px per row and
+/// margins, on 490 px).
+fn legend_height(rows: usize) -> f64 {
+    ((25 * rows + 30) as f64 / 490.0).min(0.5)
 }
 
 const SLIDING: RGBColor = RGBColor(31, 119, 180);
@@ -64,6 +129,32 @@ fn draw(points: &[Fig6Point], fit: &Fig6Fit, title: &str) -> Result<String, Plot
     let betas = points.iter().map(|p| p.beta).filter(|b| b.is_finite());
     let y_min = betas.clone().fold(-1.05f64, |a, b| a.min(b - 0.05));
     let y_max = betas.fold(fit.beta0.max(0.9) + 0.1, |a, b| a.max(b + 0.05));
+    let kink = fit.kink_psi.min(x_max);
+    let hinge = [
+        (0.0, -1.0),
+        (kink, -1.0 + fit.slope * kink),
+        (x_max, (-1.0 + fit.slope * x_max).min(fit.beta0)),
+    ];
+    let label = match fit.not_determined {
+        None => format!(
+            "fit: β₀ = {:.3}, μ₀ = {:.4}, e = {:.3}",
+            fit.beta0, fit.mu0, fit.e
+        ),
+        Some(why) => format!("fit (not determined: {why})"),
+    };
+    let label_chars = label.chars().count();
+    let band = fit.beta0_ci95.is_some() && fit.not_determined.is_none();
+    let legend_size = (3 + usize::from(band), label_chars);
+    // Where every corner would hide a point, the axis reaches down by the legend's height: it
+    // then sits below the data (which stay above the old y_min) and the hinge (above -1).
+    let (mut corner, covered) = legend_corner(points, &hinge, (x_max, y_min, y_max), legend_size);
+    let y_min = if covered > 0 {
+        let frac = legend_height(legend_size.0);
+        corner = SeriesLabelPosition::LowerRight;
+        y_min - frac / (1.0 - frac) * (y_max - y_min)
+    } else {
+        y_min
+    };
 
     let mut svg = String::new();
     {
@@ -95,7 +186,7 @@ fn draw(points: &[Fig6Point], fit: &Fig6Fit, title: &str) -> Result<String, Plot
             .map_err(e)?;
         // beta_0's 95% interval along the plateau.
         if let Some((lo, hi)) = fit.beta0_ci95
-            && fit.converged
+            && fit.not_determined.is_none()
         {
             chart
                 .draw_series(std::iter::once(Rectangle::new(
@@ -118,7 +209,7 @@ fn draw(points: &[Fig6Point], fit: &Fig6Fit, title: &str) -> Result<String, Plot
                 BLACK.mix(0.3).stroke_width(1),
             ))
             .map_err(e)?;
-        if fit.converged && fit.kink_psi < x_max {
+        if fit.not_determined.is_none() && fit.kink_psi < x_max {
             chart
                 .draw_series(DashedLineSeries::new(
                     [(fit.kink_psi, y_min), (fit.kink_psi, fit.beta0)],
@@ -150,27 +241,62 @@ fn draw(points: &[Fig6Point], fit: &Fig6Fit, title: &str) -> Result<String, Plot
             .map_err(e)?
             .label(format!("rolling ({})", rolling.len()))
             .legend(|(x, y)| TriangleMarker::new((x + 10, y), 7, ROLLING.filled()));
-        let kink = fit.kink_psi.min(x_max);
-        let hinge = [
-            (0.0, -1.0),
-            (kink, -1.0 + fit.slope * kink),
-            (x_max, (-1.0 + fit.slope * x_max).min(fit.beta0)),
-        ];
-        let label = if fit.converged {
-            format!(
-                "fit: β₀ = {:.3}, μ₀ = {:.4}, e = {:.3}",
-                fit.beta0, fit.mu0, fit.e
-            )
-        } else {
-            "fit (not determined: a branch has no data)".to_string()
-        };
         chart
             .draw_series(LineSeries::new(hinge, BLACK.stroke_width(2)))
             .map_err(e)?
             .label(label)
             .legend(|(x, y)| PathElement::new([(x, y), (x + 20, y)], BLACK.stroke_width(2)));
-        super::legend(&mut chart, SeriesLabelPosition::LowerRight, 19)?;
+        super::legend(&mut chart, corner, 19)?;
         root.present().map_err(e)?;
     }
     Ok(svg)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn at(psi: f64, beta: f64) -> Fig6Point {
+        Fig6Point {
+            psi,
+            beta,
+            sliding: false,
+        }
+    }
+
+    /// Known answers on a plot of psi in [0, 10], beta in [-1.5, 1.5] with the paper's hinge
+    /// (kink at psi 3, plateau 0.5): the legend of 3 rows and a 30-character label takes the
+    /// right 48% (380 px of 785) and the lower 21% (105 px of 490) in the lower right.
+    #[test]
+    fn the_legend_goes_where_it_hides_no_point() {
+        let hinge = [(0.0, -1.0), (3.0, 0.5), (10.0, 0.5)];
+        let range = (10.0, -1.5, 1.5);
+        let size = (3, 30);
+        // Nothing in the lower right: it stays there.
+        let (pos, covered) = legend_corner(&[at(1.0, 0.0), at(8.0, 0.5)], &hinge, range, size);
+        assert!(matches!(pos, SeriesLabelPosition::LowerRight) && covered == 0);
+        // A point there: the upper left, which hides neither a point nor the line, instead.
+        let (pos, covered) = legend_corner(&[at(8.0, -1.3)], &hinge, range, size);
+        assert!(matches!(pos, SeriesLabelPosition::UpperLeft) && covered == 0);
+        // A point in every corner: one is covered wherever it goes (the axis then makes room).
+        let corners = [at(9.0, -1.4), at(0.5, 1.4), at(0.5, -1.4), at(9.0, 1.4)];
+        let (_, covered) = legend_corner(&corners, &hinge, range, size);
+        assert_eq!(covered, 1);
+        // The figure then reaches down by the legend's height: from -1.45 to about -2.2, so a
+        // tick at -2.0 appears; with the lower right free it does not.
+        let fit = Fig6Fit {
+            slope: 0.5,
+            beta0: 0.5,
+            kink_psi: 3.0,
+            beta0_ci95: None,
+            mu0: 0.1,
+            e: 0.9,
+            not_determined: None,
+        };
+        let svg = fig6_svg(&corners, &fit, "t").unwrap();
+        assert!(svg.contains("\n-2.0\n"), "no tick at -2.0");
+        let free = [at(0.5, -1.4), at(0.5, 1.4), at(9.0, 1.4)];
+        let svg = fig6_svg(&free, &fit, "t").unwrap();
+        assert!(!svg.contains("\n-2.0\n") && svg.contains("\n-1.0\n"));
+    }
 }

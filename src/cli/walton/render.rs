@@ -25,6 +25,10 @@ pub(super) fn fig6_fit(fit: &WaltonFit) -> Fig6Fit {
         beta0_ci95: fit.beta0.ci95,
         mu0: fit.mu0.value,
         e: fit.e.value,
-        converged: fit.converged,
+        not_determined: (!fit.converged).then_some(if fit.plateau_outside() {
+            "β₀ outside [−1, 1]: noise"
+        } else {
+            "a branch has no data"
+        }),
     }
 }

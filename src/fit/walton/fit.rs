@@ -383,7 +383,7 @@ pub fn fit(measured: &[Measured], options: &FitOptions) -> Result<WaltonFit> {
     // §4.4). A plateau level outside it is the noise of tangential velocities too small to
     // measure (nearly head-on collisions: 10 of them at incidence 0 gave beta0 = 1.11 +- 0.55,
     // "converged"), not a property of the spheres.
-    let outside = hinge.shape != HingeShape::NoRolling && !(-1.0..=1.0).contains(&hinge.beta0);
+    let outside = plateau_outside(&hinge);
     let message = match hinge.shape {
         _ if outside => format!(
             "not determined: the rolling plateau's level, beta0 = {}, lies outside Walton's range [-1, 1] (above 1 a collision gains energy); its betas scatter by {} (rms residual): the tangential velocities are mostly noise at these angles of incidence",
@@ -475,7 +475,19 @@ pub fn fit(measured: &[Measured], options: &FitOptions) -> Result<WaltonFit> {
     })
 }
 
+/// Whether the hinge's plateau (determined: some collision reaches it) lies outside Walton's
+/// range [-1, 1] of beta_0.
+fn plateau_outside(h: &HingeFit) -> bool {
+    h.shape != HingeShape::NoRolling && !(-1.0..=1.0).contains(&h.beta0)
+}
+
 impl WaltonFit {
+    /// Whether beta_0 is not determined because the plateau's level lies outside [-1, 1] (see
+    /// `message`), rather than because a branch has no collisions.
+    pub fn plateau_outside(&self) -> bool {
+        plateau_outside(&self.hinge)
+    }
+
     /// The paper's critical angle of incidence gamma_0 in degrees (Fig. 1: cot gamma = v_n/v_s,
     /// 180 degrees head-on): cot gamma_0 = -psi*.
     pub fn gamma0_deg(&self) -> f64 {
