@@ -241,8 +241,8 @@ fn short_value(x: f64) -> String {
 }
 
 /// The fit's parameters as the tables show them: a value, a 95% bound, or "not determined" (the
-/// minimiser's end on a plateau is arbitrary: printed as a value it read as a result; the curve
-/// drawn from it is the fitted one all the same).
+/// minimiser's end on a plateau is arbitrary: printed as a value it read as a result; Fig. 7
+/// draws such a fit over the data's own speeds only, where the data pin it).
 fn describe(f: &FitResult) -> String {
     let parts: Vec<String> = f
         .params
