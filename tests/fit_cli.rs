@@ -929,14 +929,16 @@ fn a_curve_with_an_undetermined_parameter_spans_only_the_data() {
         text += &format!("12.7,{v},{},0.005\n", 1.0 - 0.05 * v.powf(0.3) + wiggle);
     }
     let many = write(&dir, "one_size.csv", &text);
-    for (f, note) in [
+    for (f, note, which) in [
         (
             &one,
             "powerlaw not drawn: a parameter is not determined, and the data have one speed",
+            "A, b",
         ),
         (
             &many,
             "powerlaw over the data&apos;s speeds only: a parameter is not determined",
+            "A, a",
         ),
     ] {
         let out = dir.join(format!("out-{}", f.len()));
@@ -954,6 +956,13 @@ fn a_curve_with_an_undetermined_parameter_spans_only_the_data() {
         let params = std::fs::read_to_string(out.join("params.json")).unwrap();
         let doc: serde_json::Value = serde_json::from_str(&params).unwrap();
         assert_eq!(doc["preferred"], "powerlaw", "{f}");
+        // The table and params.md say that the preferred model is no law to export.
+        let caveat = format!(
+            "its {which} are not determined by these data, so it cannot be exported as a law"
+        );
+        assert!(r.stdout.contains(&caveat), "{}", r.stdout);
+        let md = std::fs::read_to_string(out.join("params.md")).unwrap();
+        assert!(md.contains(&caveat), "params.md");
         let svg = std::fs::read_to_string(out.join("fig7.svg")).unwrap();
         assert!(svg.contains(note), "{f}: no '{note}'");
         let (curve, markers) = curve_and_marker_xs(&svg);

@@ -325,7 +325,31 @@ fn preferred_line(set: &FitSet) -> Option<String> {
     let c = set.comparison.as_ref()?;
     let name = c.preferred.map_or("none", |m| m.name());
     let why = c.unranked.as_deref().unwrap_or(PREFERENCE_RULE);
-    Some(format!("preferred model: {name} ({why})"))
+    // The best description of the data need not be a law to use: data at one speed fit the
+    // power law best with A and b determined only together, and `export` refuses it.
+    let undetermined: Vec<&str> = c
+        .preferred
+        .and_then(|m| set.fits.iter().find(|f| f.model == m))
+        .map(|f| {
+            f.params
+                .iter()
+                .filter(|p| p.status == ParamStatus::Unconstrained)
+                .map(|p| p.key)
+                .collect()
+        })
+        .unwrap_or_default();
+    let caveat = if undetermined.is_empty() {
+        String::new()
+    } else {
+        format!(
+            "; its {} not determined by these data, so it cannot be exported as a law",
+            match undetermined[..] {
+                [one] => format!("{one} is"),
+                _ => format!("{} are", undetermined.join(", ")),
+            }
+        )
+    };
+    Some(format!("preferred model: {name} ({why}){caveat}"))
 }
 
 fn note_lines(set: &FitSet) -> Vec<String> {
