@@ -319,9 +319,10 @@ fn bad_input_gives_one_clear_line_and_no_files() {
                 "--v-range",
                 "1,2",
             ],
-            // What to do instead, and only what works: the file has vm, which min tends to as
-            // sigma_y grows; a --sigma-y-pa flag beside the file is refused.
-            "sigma_y' has no value (status lower_bound: the data do not determine it); export another model (the fit tends to 'vm' as sigma_y grows without bound), or give the law as numbers without the fit",
+            // What to do instead, and only what works: the file's models that have every
+            // value, among them vm, which min tends to as sigma_y grows; a --sigma-y-pa flag
+            // beside the file is refused.
+            "sigma_y' has no value (status lower_bound: the data do not determine it); export another model (every parameter has a value in: vm, pm, product, powerlaw; the fit tends to 'vm' as sigma_y grows without bound), or give the law as numbers without the fit",
         ),
         (
             vec!["export", params, "--engine", "constant-e"],

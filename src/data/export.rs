@@ -306,12 +306,7 @@ impl FitParamsFile {
                          do not determine it); export another model{}, or give the law as numbers \
                          without the fit (its model, parameters and material)",
                         spec.key,
-                        limit_model(kind, spec.key, status)
-                            .filter(|m| self.fits.iter().any(|f| f.model == *m))
-                            .map_or(String::new(), |m| format!(
-                                " (the fit tends to '{m}' as {} grows without bound)",
-                                spec.key
-                            ))
+                        self.alternatives(kind, spec.key, status)
                     ),
                 )
             })?;
@@ -325,6 +320,35 @@ impl FitParamsFile {
             )
         })?;
         Ok((curve, entry))
+    }
+}
+
+impl FitParamsFile {
+    /// What to export instead of `kind`, whose `key` has no value: " (every parameter has a
+    /// value in: vm, pm; the fit tends to 'vm' as sigma_y grows without bound)". The file's
+    /// converged fits that export can take, in its order, and the model `kind` tends to where
+    /// that is one of them; empty where neither applies.
+    fn alternatives(&self, kind: ModelKind, key: &str, status: &str) -> String {
+        let ok: Vec<&str> = self
+            .fits
+            .iter()
+            .filter(|f| f.converged != Some(false) && f.params.iter().all(|p| p.1.is_some()))
+            .map(|f| f.model.as_str())
+            .collect();
+        let mut hints = Vec::new();
+        if !ok.is_empty() {
+            hints.push(format!("every parameter has a value in: {}", ok.join(", ")));
+        }
+        if let Some(m) = limit_model(kind, key, status).filter(|m| ok.contains(m)) {
+            hints.push(format!(
+                "the fit tends to '{m}' as {key} grows without bound"
+            ));
+        }
+        if hints.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", hints.join("; "))
+        }
     }
 }
 
