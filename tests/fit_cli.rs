@@ -39,6 +39,16 @@ fn scratch(tag: &str) -> PathBuf {
     d
 }
 
+/// `restitution fit DATA --material nylon [--model MODEL] --out OUT`.
+fn fit_out(data: &str, model: Option<&str>, out: &Path) -> Run {
+    let mut args = vec!["fit", data, "--material", "nylon"];
+    if let Some(m) = model {
+        args.extend(["--model", m]);
+    }
+    args.extend(["--out", out.to_str().unwrap()]);
+    run(&args)
+}
+
 fn write(dir: &Path, name: &str, text: &str) -> String {
     let p = dir.join(name);
     std::fs::write(&p, text).unwrap();
@@ -362,14 +372,7 @@ fn each_bad_input_gets_one_clear_error_and_no_output() {
     for (name, text, expected) in cases {
         let path = write(&dir, &format!("{name}.csv"), &text);
         let out = dir.join(format!("{name}_out"));
-        let r = run(&[
-            "fit",
-            &path,
-            "--material",
-            "nylon",
-            "--out",
-            out.to_str().unwrap(),
-        ]);
+        let r = fit_out(&path, None, &out);
         assert!(!r.ok, "{name}: exit 0");
         assert!(r.stdout.is_empty(), "{name}: stdout {}", r.stdout);
         let lines: Vec<&str> = r.stderr.lines().collect();
@@ -471,16 +474,7 @@ fn exact_and_master_agree_through_the_cli() {
 #[test]
 fn figures_do_not_print_an_undetermined_parameter_as_a_value() {
     let dir = scratch("undetermined");
-    let r = run(&[
-        "fit",
-        "data/wall_example.csv",
-        "--material",
-        "nylon",
-        "--model",
-        "powerlaw",
-        "--out",
-        dir.to_str().unwrap(),
-    ]);
+    let r = fit_out("data/wall_example.csv", Some("powerlaw"), &dir);
     assert!(r.ok, "{}", r.stderr);
     assert!(r.stdout.contains("not determined"), "{}", r.stdout);
     let svg = std::fs::read_to_string(dir.join("residuals.svg")).unwrap();
@@ -499,14 +493,7 @@ fn figures_do_not_print_an_undetermined_parameter_as_a_value() {
 fn the_committed_fit_report_is_current() {
     let dir = scratch("current");
     let out = dir.join("fit");
-    let r = run(&[
-        "fit",
-        "data/fig7_nylon.csv",
-        "--material",
-        "nylon",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let r = fit_out("data/fig7_nylon.csv", None, &out);
     assert!(r.ok, "{}", r.stderr);
     let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/fit");
     for f in REPORT_FILES {
@@ -533,16 +520,7 @@ fn many_sizes_are_counted_not_listed() {
     }
     let data = write(&dir, "sizes.csv", &csv);
     let out = dir.join("out");
-    let r = run(&[
-        "fit",
-        &data,
-        "--material",
-        "nylon",
-        "--model",
-        "vm",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let r = fit_out(&data, Some("vm"), &out);
     assert!(r.ok, "{}", r.stderr);
     let head = r.stdout.lines().next().unwrap();
     assert!(
@@ -585,16 +563,7 @@ fn figures_draw_a_marker_once_per_pixel_and_many_as_a_density() {
     let figures = |name: &str, text: &str| {
         let data = write(&dir, name, text);
         let out = dir.join(name.replace(".csv", ""));
-        let r = run(&[
-            "fit",
-            &data,
-            "--material",
-            "nylon",
-            "--model",
-            "vm",
-            "--out",
-            out.to_str().unwrap(),
-        ]);
+        let r = fit_out(&data, Some("vm"), &out);
         assert!(r.ok, "{}", r.stderr);
         let read = |f: &str| std::fs::read_to_string(out.join(f)).unwrap();
         (read("fig7.svg"), read("residuals.svg"))
@@ -686,16 +655,7 @@ fn exact_fits_are_not_ranked_by_aic() {
         "d_mm,v_n_m_s,e\n10,1,0.9\n10,1,0.9\n10,1,0.9\n",
     );
     let out = dir.join("out");
-    let r = run(&[
-        "fit",
-        &path,
-        "--material",
-        "nylon",
-        "--model",
-        "all",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let r = fit_out(&path, Some("all"), &out);
     assert!(r.ok, "{}", r.stderr);
     assert!(
         r.stdout.contains(
@@ -850,16 +810,7 @@ fn the_figure_legend_makes_room_for_pair_labels() {
     }
     let f = write(&dir, "pairs.csv", &text);
     let out = dir.join("out");
-    let r = run(&[
-        "fit",
-        &f,
-        "--material",
-        "nylon",
-        "--model",
-        "vm",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let r = fit_out(&f, Some("vm"), &out);
     assert!(r.ok, "{}", r.stderr);
     let svg = std::fs::read_to_string(out.join("fig7.svg")).unwrap();
     let at = svg
@@ -942,16 +893,7 @@ fn a_curve_with_an_undetermined_parameter_spans_only_the_data() {
         ),
     ] {
         let out = dir.join(format!("out-{}", f.len()));
-        let r = run(&[
-            "fit",
-            f,
-            "--material",
-            "nylon",
-            "--model",
-            "all",
-            "--out",
-            out.to_str().unwrap(),
-        ]);
+        let r = fit_out(f, Some("all"), &out);
         assert!(r.ok, "{}", r.stderr);
         let params = std::fs::read_to_string(out.join("params.json")).unwrap();
         let doc: serde_json::Value = serde_json::from_str(&params).unwrap();
