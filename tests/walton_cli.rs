@@ -38,6 +38,17 @@ fn run(args: &[&str]) -> (bool, String, String) {
     )
 }
 
+/// `restitution walton fit PATH --material nylon`: (success, stdout, stderr).
+fn fit_nylon(path: &Path) -> (bool, String, String) {
+    run(&[
+        "walton",
+        "fit",
+        path.to_str().unwrap(),
+        "--material",
+        "nylon",
+    ])
+}
+
 fn shipped() -> String {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("data/oblique_collisions.csv")
@@ -221,13 +232,7 @@ fn cli_bad_input_errors_name_the_place() {
     });
     let path = dir.join("receding.csv");
     std::fs::write(&path, receding).unwrap();
-    let (ok, _, err) = run(&[
-        "walton",
-        "fit",
-        path.to_str().unwrap(),
-        "--material",
-        "nylon",
-    ]);
+    let (ok, _, err) = fit_nylon(&path);
     assert!(!ok);
     assert!(
         err.contains(&format!(":{data_line}:")) && err.contains("not approaching"),
@@ -248,13 +253,7 @@ fn cli_bad_input_errors_name_the_place() {
     });
     let path = dir.join("approaching.csv");
     std::fs::write(&path, approaching).unwrap();
-    let (ok, stdout, err) = run(&[
-        "walton",
-        "fit",
-        path.to_str().unwrap(),
-        "--material",
-        "nylon",
-    ]);
+    let (ok, stdout, err) = fit_nylon(&path);
     assert!(!ok && stdout.is_empty(), "{stdout}");
     assert_eq!(err.trim_end().lines().count(), 1, "{err}");
     assert!(
@@ -267,13 +266,7 @@ fn cli_bad_input_errors_name_the_place() {
     // runs, but a warning names the row whose momentum is not conserved.
     let path = dir.join("typo.csv");
     std::fs::write(&path, with_cell("v1x_post_m_s", "-1e40")).unwrap();
-    let (ok, stdout, err) = run(&[
-        "walton",
-        "fit",
-        path.to_str().unwrap(),
-        "--material",
-        "nylon",
-    ]);
+    let (ok, stdout, err) = fit_nylon(&path);
     assert!(ok, "{err}");
     // Its absurd numbers in exponent form (fixed decimals had printed 40-digit values).
     let spread = stdout
@@ -309,13 +302,7 @@ fn cli_bad_input_errors_name_the_place() {
                 10,inf,0,0.005,0,0,1.5,-2,0,0.3,0,0,0.93,1.8,-114,0,0,0\n";
     let path = dir.join("wall.csv");
     std::fs::write(&path, wall).unwrap();
-    let (ok, _, err) = run(&[
-        "walton",
-        "fit",
-        path.to_str().unwrap(),
-        "--material",
-        "nylon",
-    ]);
+    let (ok, _, err) = fit_nylon(&path);
     assert!(!ok);
     assert!(
         err.contains(":3: column 'v2x_m_s'") && err.contains("'0.3'") && err.contains("wall"),
@@ -324,13 +311,7 @@ fn cli_bad_input_errors_name_the_place() {
     // Too few collisions to fit (the same wall row, now at rest, once).
     let path = dir.join("one.csv");
     std::fs::write(&path, wall.replace(",0.3,0,0,0.93", ",0,0,0,0.93")).unwrap();
-    let (ok, _, err) = run(&[
-        "walton",
-        "fit",
-        path.to_str().unwrap(),
-        "--material",
-        "nylon",
-    ]);
+    let (ok, _, err) = fit_nylon(&path);
     assert!(
         !ok && err.contains("cannot fit") && err.contains(">= 3"),
         "{err}"
@@ -355,13 +336,7 @@ fn cli_bad_input_errors_name_the_place() {
     );
     // A changed field count names the line.
     let path = dir.join("not_a_number.csv");
-    let (ok, _, err) = run(&[
-        "walton",
-        "fit",
-        path.to_str().unwrap(),
-        "--material",
-        "nylon",
-    ]);
+    let (ok, _, err) = fit_nylon(&path);
     assert!(
         !ok && err.contains(&format!(":{data_line}:")) && err.contains("fields"),
         "{err}"
