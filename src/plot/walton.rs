@@ -155,6 +155,15 @@ fn draw(points: &[Fig6Point], fit: &Fig6Fit, title: &str) -> Result<String, Plot
     } else {
         y_min
     };
+    // Betas near +-f64::MAX (a tangential speed of 1e-160 m/s before and 1e148 after) make the
+    // axis's span infinite, and the axis's ticks never ended.
+    if !(y_max - y_min).is_finite() {
+        return Err(PlotFailure::NothingToDraw(format!(
+            "betas from {} to {}: a span beyond the range of a double",
+            crate::error::Num(y_min),
+            crate::error::Num(y_max)
+        )));
+    }
 
     let mut svg = String::new();
     {
@@ -298,5 +307,25 @@ mod tests {
         let free = [at(0.5, -1.4), at(0.5, 1.4), at(9.0, 1.4)];
         let svg = fig6_svg(&free, &fit, "t").unwrap();
         assert!(!svg.contains("\n-2.0\n") && svg.contains("\n-1.0\n"));
+    }
+
+    /// Betas of +-1e308 span more than a double: an error in bounded time (the axis's ticks had
+    /// never ended); +-1e300 still draw.
+    #[test]
+    fn betas_beyond_a_doubles_span_are_an_error_not_a_hang() {
+        let fit = Fig6Fit {
+            slope: 0.5,
+            beta0: 0.5,
+            kink_psi: 3.0,
+            beta0_ci95: None,
+            mu0: 0.1,
+            e: 0.9,
+            not_determined: Some("a branch has no data"),
+        };
+        for (b, ok) in [(1e300, true), (1e308, false)] {
+            let pts = [at(9.0, -b), at(9.5, b), at(0.5, b), at(0.5, -b)];
+            let r = fig6_svg(&pts, &fit, "t");
+            assert_eq!(r.is_ok(), ok, "{b}: {:?}", r.err().map(|e| e.to_string()));
+        }
     }
 }
