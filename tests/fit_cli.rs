@@ -926,3 +926,70 @@ fn a_curve_with_an_undetermined_parameter_spans_only_the_data() {
         }
     }
 }
+
+/// The tick labels of an SVG's text elements.
+fn svg_texts(svg: &str) -> Vec<String> {
+    svg.split("<text")
+        .skip(1)
+        .filter_map(|t| {
+            let body = &t[t.find('>')? + 1..];
+            Some(body[..body.find("</text>")?].trim().to_string())
+        })
+        .collect()
+}
+
+/// Fig. 7 and the residuals with absurd but valid data: an e of 1e-300 had been drawn at the
+/// axis's floor, 1e-4, as if it were 1e-4; an e_err of 1e99 had stretched the e axis to 1e99;
+/// speeds over ten decades printed 1, 2 and 5 of every decade on top of each other; a point
+/// with e = 0 vanished without a word; a residual of 1e100 printed its 101 digits.
+#[test]
+fn the_figures_show_every_point_truthfully_and_legibly() {
+    let dir = scratch("absurd-figures");
+    let f = write(
+        &dir,
+        "absurd.csv",
+        "d_mm,v_n_m_s,e,e_err\n10,1e-5,1e-300,0.1\n10,1e5,0.4,0.1\n10,1e-3,0.9,0.1\n\
+         0.1,1,0.9,1e99\n10,2,0,0.1\n",
+    );
+    let out = dir.join("out");
+    let r = fit_out(&f, None, &out);
+    assert!(r.ok, "{}", r.stderr);
+    let fig7 = svg_texts(&std::fs::read_to_string(out.join("fig7.svg")).unwrap());
+    // The e axis reaches the smallest e (its lowest tick is 1e-300) and stops near 1: the bar
+    // of 1e99 runs to the frame instead.
+    assert!(fig7.iter().any(|t| t == "1e-300"), "{fig7:?}");
+    assert!(fig7.iter().any(|t| t == "1"), "{fig7:?}");
+    assert!(
+        !fig7
+            .iter()
+            .any(|t| t.starts_with("1e9") || t.contains("e1")),
+        "{fig7:?}"
+    );
+    assert!(
+        fig7.iter()
+            .any(|t| t == "1 point with e = 0 not drawn (no place on a log axis)"),
+        "{fig7:?}"
+    );
+    // Ten decades of speed: at most ten labels, the powers of ten 1e-4 .. 1e4 (every other).
+    for t in ["1e-4", "0.01", "1", "100", "10000"] {
+        assert!(fig7.iter().any(|x| x == t), "no tick {t}: {fig7:?}");
+    }
+    assert!(!fig7.iter().any(|x| x == "2" || x == "0.5"), "{fig7:?}");
+
+    let f = write(
+        &dir,
+        "far.csv",
+        "d_mm,v_n_m_s,e,e_err\n10,1,1e100,1e-10\n10,2,0.4,1e-10\n10,3,0.3,0.1\n10,1.5,0.5,1\n",
+    );
+    let out = dir.join("far");
+    let r = fit_out(&f, Some("vm"), &out);
+    assert!(r.ok, "{}", r.stderr);
+    let res = svg_texts(&std::fs::read_to_string(out.join("residuals.svg")).unwrap());
+    assert!(res.iter().all(|t| t.len() < 80), "{res:?}");
+    assert!(
+        res.iter()
+            .any(|t| t.starts_with("vm: chi2/dof = 3.333e219")),
+        "{res:?}"
+    );
+    assert!(res.iter().any(|t| t == "1e110"), "{res:?}");
+}

@@ -92,16 +92,20 @@ fn draw(tr: &Translation, title: &str) -> Result<String, PlotFailure> {
         let top = top.titled(title, ("sans-serif", 26)).map_err(err)?;
         let (left, right) = top.split_horizontally(650);
         let xr = (range.lo_m_s..range.hi_m_s).log_scale();
+        // Enough decimals to tell the ticks apart (an e near 1 over a span of 1e-4 had printed
+        // two ticks as "1.0"), and room for them beside the axis's name.
+        let decimals = (-((y1 - y0) / 10.0).log10()).ceil().clamp(1.0, 15.0) as usize;
         let mut a = ChartBuilder::on(&left)
             .margin(15)
             .x_label_area_size(55)
-            .y_label_area_size(75)
+            .y_label_area_size(75 + 10 * decimals.saturating_sub(3) as u32)
             .caption("e(v): fitted and exported laws", ("sans-serif", 22))
             .build_cartesian_2d(xr.clone(), y0..y1)
             .map_err(err)?;
         a.configure_mesh()
             .x_labels(12)
             .x_label_formatter(&tick)
+            .y_label_formatter(&|v| format!("{v:.decimals$}"))
             .x_desc("normal impact speed v (m/s)")
             .y_desc("e")
             .axis_desc_style(("sans-serif", 20))
@@ -205,7 +209,7 @@ fn legend_row(
     ];
     for (name, dash, gap) in styles {
         let label = if name == "viscoelastic law" {
-            format!("viscoelastic law (η = {eta:.4} kg/(s m))")
+            format!("viscoelastic law (η = {} kg/(s m))", super::short(eta))
         } else {
             name.to_string()
         };

@@ -8,7 +8,7 @@ mod residuals;
 pub use fig7::fig7_svg;
 pub use residuals::residuals_svg;
 
-use super::PlotFailure;
+use super::{PlotFailure, short};
 use crate::fit::dataset::{FitData, Group};
 use crate::fit::result::{FitResult, ParamStatus};
 use plotters::coord::CoordTranslate;
@@ -166,13 +166,16 @@ fn draw_legend(
     Ok(())
 }
 
-/// Tick values for a log axis: 1, 2, 5 per decade over wide ranges (over more than
-/// MANY_DECADES, 1 in every so many decades); over less than a factor 3 (e on a log axis usually
-/// spans 0.7-1.1) evenly spaced round values, 4 to 10 of them. None for a range that is not
-/// finite, positive and increasing ([`crate::plot::log_axis`] gives none such), and none below
-/// 1e-307 (the decades are powers of ten, which underflow beyond).
+/// Tick values for a log axis: 1, 2, 5 per decade over up to three decades, the powers of ten
+/// over more, and over more than MAX_LABELS decades every 2nd, 5th, 10th, ... power (exponents
+/// a multiple of it); over less than a factor 3 (e on a log axis usually spans 0.7-1.1) evenly
+/// spaced round values, 4 to 10 of them. None for a range that is not finite, positive and
+/// increasing ([`crate::plot::log_axis`] gives none such), and none below 1e-307 (the decades
+/// are powers of ten, which underflow beyond).
 fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
-    const MANY_DECADES: i32 = 24;
+    // A label such as "2.5e-7" in the 16 px font is about 60 px wide and the figures' axes are
+    // about 880 px long: 1, 2, 5 in each of eight decades (25 labels) had run into each other.
+    const MAX_LABELS: i32 = 10;
     if !(lo > 0.0 && lo < hi && hi.is_finite()) {
         return Vec::new();
     }
@@ -192,34 +195,32 @@ fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
         let last = (hi / step).floor() as i64;
         return (first..=last).map(|k| k as f64 * step).collect();
     }
+    // Decade by decade from the one below lo (but not below 1e-307: a decade that underflows to 0
+    // would never grow), so at most about 615 of them.
+    let first = (lo.log10().floor() as i32).max(-307);
+    let last = hi.log10().ceil() as i32;
+    let decades = last - first;
     let mantissas: &[f64] = if hi / lo < 30.0 {
         &[1.0, 2.0, 3.0, 5.0]
-    } else {
+    } else if hi / lo <= 1e3 {
         &[1.0, 2.0, 5.0]
-    };
-    // Decade by decade from the one below lo (but not below 1e-307: a decade that underflows to 0
-    // would never grow), so at most about 615 of them; over many, 1 in every `every` of them.
-    let first = (lo.log10().floor() as i32).max(-307);
-    let decades = hi.log10().ceil() as i32 - first;
-    let (mantissas, every) = if decades > MANY_DECADES {
-        (&[1.0][..], decades / MANY_DECADES + 1)
     } else {
-        (mantissas, 1)
+        &[1.0]
     };
+    let every = [1, 2, 5, 10, 20, 50, 100, 200]
+        .into_iter()
+        .find(|k| decades <= MAX_LABELS * k)
+        .unwrap_or(500);
     let mut out = Vec::new();
-    let mut decade = 10f64.powi(first);
-    let mut k = 0;
-    while decade <= hi {
-        if k % every == 0 {
-            for &m in mantissas {
-                let t = m * decade;
-                if t >= lo && t <= hi {
-                    out.push(t);
-                }
+    for exponent in (first..=last).filter(|x| x.rem_euclid(every) == 0) {
+        // Parsed, not powi: 10^-200 rounded as the literal 1e-200 is.
+        let decade: f64 = format!("1e{exponent}").parse().unwrap_or(0.0);
+        for &m in mantissas {
+            let t = m * decade;
+            if t >= lo && t <= hi {
+                out.push(t);
             }
         }
-        decade *= 10.0;
-        k += 1;
     }
     out
 }
@@ -228,16 +229,6 @@ fn log_points(lo: f64, hi: f64, n: usize) -> Vec<f64> {
     (0..n)
         .map(|k| (lo.ln() + (hi.ln() - lo.ln()) * k as f64 / (n - 1) as f64).exp())
         .collect()
-}
-
-fn short_value(x: f64) -> String {
-    let a = x.abs();
-    if (1e-2..1e4).contains(&a) {
-        // Rounded to 1e-3 and printed shortest, so ticks read 0.92, not 0.9200000000000002.
-        format!("{}", (x * 1e3).round() / 1e3)
-    } else {
-        format!("{x:.3e}")
-    }
 }
 
 /// The fit's parameters as the tables show them: a value, a 95% bound, or "not determined" (the
@@ -250,7 +241,7 @@ fn describe(f: &FitResult) -> String {
         .map(|p| {
             let unit = crate::fit::models::unit_after(p.unit);
             let shown = |rel: &str, x: Option<f64>| match x {
-                Some(x) => format!("{} {rel} {}{unit}", p.key, short_value(x)),
+                Some(x) => format!("{} {rel} {}{unit}", p.key, short(x)),
                 None => format!("{} not determined", p.key),
             };
             match p.status {
@@ -278,7 +269,7 @@ mod tests {
         let t = log_ticks(0.88, 1.03);
         assert!(t.len() >= 4 && t.len() <= 10, "{t:?}");
         assert!(t.iter().all(|&x| (0.88..=1.03).contains(&x)));
-        assert_eq!(short_value(t[2]), "0.92");
+        assert_eq!(short(t[2]), "0.92");
     }
 
     #[test]
@@ -307,9 +298,31 @@ mod tests {
             assert!(t.len() <= 100, "{lo} {hi}: {} ticks", t.len());
             assert!(t.iter().all(|&x| lo <= x && x <= hi), "{lo} {hi}: {t:?}");
         }
-        // Wide ranges keep their decades' 1s, no more than about MANY_DECADES of them.
+        // Wide ranges keep some of their decades' 1s, no more labels than fit along the axis.
         let t = log_ticks(5e-324, max);
-        assert!((20..=40).contains(&t.len()), "{t:?}");
-        assert_eq!(log_ticks(1e-3, 1e5).len(), 8 * 3 + 1);
+        assert!((5..=11).contains(&t.len()), "{t:?}");
+        assert_eq!(t[1], 1e-200, "{t:?}");
+    }
+
+    #[test]
+    fn wide_axes_keep_their_labels_apart() {
+        // Eight decades of speeds printed 25 labels on top of each other.
+        assert_eq!(
+            log_ticks(1e-3, 1e5),
+            vec![1e-3, 1e-2, 0.1, 1.0, 10.0, 100.0, 1e3, 1e4, 1e5]
+        );
+        assert_eq!(log_ticks(8e-6, 1.2e5), vec![1e-4, 1e-2, 1.0, 100.0, 1e4]);
+        assert_eq!(
+            log_ticks(0.05, 20.0),
+            vec![0.05, 0.1, 0.2, 0.5, 1.0, 2.0, 5.0, 10.0, 20.0]
+        );
+        let labels: Vec<String> = [1e-5, 2.5e-7, 0.92, 2236.423, 1e6, -0.0012346]
+            .iter()
+            .map(|&x| short(x))
+            .collect();
+        assert_eq!(
+            labels,
+            ["1e-5", "2.5e-7", "0.92", "2236", "1e6", "-0.001235"]
+        );
     }
 }

@@ -24,6 +24,17 @@ pub fn colour(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
 
+/// `x` to four significant digits, printed shortest: ticks read 0.92 and 1e-5, not
+/// 0.9200000000000002 or 1.000e-5, and a legend's eta 2236, not 2236.423.
+pub fn short(x: f64) -> String {
+    let rounded: f64 = format!("{x:.3e}").parse().unwrap_or(x);
+    if (1e-3..1e6).contains(&rounded.abs()) {
+        format!("{rounded}")
+    } else {
+        format!("{rounded:e}")
+    }
+}
+
 /// The extent of a log axis over data from `lo` to `hi` with a margin of the factor `pad` on
 /// each side, in finite positive numbers: where the margin would overflow (data near f64::MAX)
 /// or underflow to 0 (subnormal data) that end stays at the data, and a range that is still one

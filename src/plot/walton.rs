@@ -137,8 +137,10 @@ fn draw(points: &[Fig6Point], fit: &Fig6Fit, title: &str) -> Result<String, Plot
     ];
     let label = match fit.not_determined {
         None => format!(
-            "fit: β₀ = {:.3}, μ₀ = {:.4}, e = {:.3}",
-            fit.beta0, fit.mu0, fit.e
+            "fit: β₀ = {}, μ₀ = {}, e = {}",
+            super::short(fit.beta0),
+            super::short(fit.mu0),
+            super::short(fit.e)
         ),
         Some(why) => format!("fit (not determined: {why})"),
     };
@@ -187,7 +189,12 @@ fn draw(points: &[Fig6Point], fit: &Fig6Fit, title: &str) -> Result<String, Plot
             .x_desc("ψ = −v_n / |v_s|   (cotangent of the angle of incidence)")
             .y_desc("β   (tangential restitution)")
             // Ticks like -1.0 + 5 * 0.2 land a rounding away from 0 and would print "-0.0".
-            .y_label_formatter(&|v| format!("{:.1}", if v.abs() < 1e-9 { 0.0 } else { *v }))
+            // Beyond 1e4 in shortest form: betas of 1e300 had printed 301 digits.
+            .y_label_formatter(&|v| match v.abs() {
+                a if a < 1e-9 => "0.0".to_string(),
+                a if a < 1e4 => format!("{v:.1}"),
+                _ => super::short(*v),
+            })
             .axis_desc_style(("sans-serif", 22))
             .label_style(("sans-serif", 18))
             .light_line_style(WHITE.mix(0.0))

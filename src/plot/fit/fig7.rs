@@ -3,14 +3,14 @@
 use super::points::{MAX_MARKERS, density_note, draw_density, draw_error_bars, one_per_pixel};
 use super::{
     Sample, colour, describe, draw_legend, draw_markers, drawn_groups, log_points, log_ticks,
-    short_value, svg_err,
+    svg_err,
 };
 use crate::fit::dataset::{FitData, Group};
 use crate::fit::engine::FitSet;
 use crate::fit::models::{ModelKind, predict_e};
 use crate::fit::result::{FitResult, ParamStatus};
 use crate::models::viscoelastic::{ContactEnd, VmMethod};
-use crate::plot::{PlotError, PlotFailure, log_axis};
+use crate::plot::{PlotError, PlotFailure, log_axis, short};
 use plotters::coord::Shift;
 use plotters::coord::combinators::{LogCoord, WithKeyPoints};
 use plotters::prelude::*;
@@ -92,6 +92,30 @@ fn span_note(
     ))
 }
 
+/// The e axis: every positive e of the data (an e of 1e-300 had been drawn at the axis's floor,
+/// 1e-4, as if it were 1e-4), 1 and at least down to 0.99, and the error bars' ends within a
+/// decade of those; a longer bar runs to the frame (an e_err of 1e99 had stretched the axis to
+/// 1e99, leaving every point on one line). e <= 0 has no place on it (the legend counts such
+/// points).
+fn e_axis(data: &FitData) -> (f64, f64) {
+    let positive = || data.obs.iter().filter(|o| o.e > 0.0);
+    let lowest = positive().map(|o| o.e).fold(0.99f64, f64::min);
+    let highest = positive().map(|o| o.e).fold(1.0f64, f64::max);
+    let (mut lo, mut hi) = (lowest, highest);
+    for o in positive() {
+        let s = o.e_err.unwrap_or(0.0);
+        if o.e - s >= lowest / 10.0 {
+            lo = lo.min(o.e - s);
+        }
+        if o.e + s <= highest * 10.0 && (o.e + s).is_finite() {
+            hi = hi.max(o.e + s);
+        }
+    }
+    // 0 < lo <= 0.99 < 1 <= hi < inf, so log_axis has an axis (a margin that would overflow
+    // leaves that end at the data).
+    log_axis(lo, hi, 1.04).unwrap_or((lo, hi))
+}
+
 /// `fig7.svg`: e against v_n on log-log axes. Data with error bars, one colour and marker per
 /// pair geometry; the fitted VM curve for each geometry (solid); the PM curve (black, dash-dot;
 /// one curve when every pair has the same V_Y, as identical spheres of one material do); the
@@ -116,24 +140,14 @@ fn draw_fig7(
     let (drawn, merged) = drawn_groups(data);
     let groups: Vec<&Group> = drawn.iter().map(|(g, _)| g).collect();
     let (mut vlo, mut vhi) = (f64::INFINITY, 0.0f64);
-    let (mut elo, mut ehi) = (f64::INFINITY, 0.0f64);
-    for (i, o) in data.obs.iter().enumerate() {
+    for o in &data.obs {
         vlo = vlo.min(o.v_n_m_s);
         vhi = vhi.max(o.v_n_m_s);
-        let s = o.e_err.unwrap_or(0.0);
-        ehi = ehi.max(o.e + s);
-        if o.e > 0.0 {
-            elo = elo.min(if o.e - s > 0.0 { o.e - s } else { o.e });
-        }
-        let _ = i;
     }
     let x_range = log_axis(vlo, vhi, 1.25).ok_or_else(|| {
         PlotFailure::NothingToDraw("no speed that is a finite positive number".into())
     })?;
-    // e + e_err may overflow: the axis then ends at the largest number.
-    let ehi = (ehi.max(1.0) * 1.03).min(f64::MAX);
-    let elo = (elo / 1.05).clamp(1e-4, 0.99);
-    let y_range = (elo, ehi);
+    let y_range = e_axis(data);
     let vs = log_points(x_range.0, x_range.1, 240);
 
     let find = |k: ModelKind| set.fits.iter().find(|f| f.model == k);
@@ -191,6 +205,17 @@ fn draw_fig7(
             ),
         ));
         legend.extend(span_note(f, f.model.name(), &groups, data, merged));
+    }
+    // e = 0 has no place on the log axis: the legend counts what the picture leaves out.
+    let zeros = data.obs.iter().filter(|o| o.e <= 0.0).count();
+    if zeros > 0 {
+        legend.push((
+            Sample::Text,
+            format!(
+                "{zeros} point{} with e = 0 not drawn (no place on a log axis)",
+                if zeros == 1 { "" } else { "s" }
+            ),
+        ));
     }
     // Each group's points, one per pixel, and whether they are drawn as a density (points.rs):
     // the chart's pixels do not depend on the legend's height below it, so a scratch chart of
@@ -312,8 +337,8 @@ fn chart_on<'a, 'b>(
         .y_desc("coefficient of restitution e")
         .axis_desc_style(("sans-serif", 20))
         .label_style(("sans-serif", 16))
-        .x_label_formatter(&|v| short_value(*v))
-        .y_label_formatter(&|e| short_value(*e))
+        .x_label_formatter(&|v| short(*v))
+        .y_label_formatter(&|e| short(*e))
         .bold_line_style(RGBColor(225, 225, 225))
         .draw()
         .map_err(svg_err)?;

@@ -2,12 +2,11 @@
 
 use super::points::{BLOCK_PX, MAX_MARKERS, draw_density, one_per_pixel};
 use super::{
-    Sample, colour, describe, draw_legend, draw_markers, drawn_groups, log_ticks, short_value,
-    svg_err,
+    Sample, colour, describe, draw_legend, draw_markers, drawn_groups, log_ticks, svg_err,
 };
 use crate::fit::dataset::FitData;
 use crate::fit::engine::FitSet;
-use crate::plot::{PlotError, PlotFailure, log_axis};
+use crate::plot::{PlotError, PlotFailure, log_axis, short};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -62,9 +61,9 @@ fn draw_residuals(data: &FitData, set: &FitSet, title: &str) -> Result<String, P
             let mut chart = ChartBuilder::on(area)
                 .caption(
                     format!(
-                        "{}: chi2/dof = {:.3}, {}",
+                        "{}: chi2/dof = {}, {}",
                         f.model.name(),
-                        f.reduced_chi2,
+                        short(f.reduced_chi2),
                         describe(f)
                     ),
                     ("sans-serif", 17),
@@ -85,9 +84,16 @@ fn draw_residuals(data: &FitData, set: &FitSet, title: &str) -> Result<String, P
                 .y_desc(ylabel)
                 .axis_desc_style(("sans-serif", 16))
                 .label_style(("sans-serif", 14))
-                .x_label_formatter(&|v| short_value(*v))
+                .x_label_formatter(&|v| short(*v))
                 .y_labels(7)
-                .y_label_formatter(&|r| format!("{}", (r * 100.0).round() / 100.0))
+                // Shortest form: a residual of 1e100 had printed its 101 digits.
+                .y_label_formatter(&|r| {
+                    if r.abs() < 1e4 {
+                        format!("{}", (r * 100.0).round() / 100.0)
+                    } else {
+                        short(*r)
+                    }
+                })
                 .light_line_style(WHITE)
                 .bold_line_style(RGBColor(225, 225, 225))
                 .draw()
