@@ -835,3 +835,62 @@ fn a_file_of_one_fit_exports_it() {
         r.stdout
     );
 }
+
+/// A lossy law as a constant e: eta = 3e4 kg/(s m) on 10 mm nylon spheres gives e from 1.2e-4
+/// at 1 m/s down to 1.2e-7; its mean e (1.8e-5) needs Tsuji's alpha = 2.149, close to critical
+/// damping (sqrt 5 = 2.236). The inversion had doubled its bracket past sqrt 5 and the export
+/// failed with "unphysical unloading state ... p = 0.0000000000000111...". Its laws.svg labels
+/// eta in short form (1e-300 had read 0.0000).
+#[test]
+fn a_lossy_law_exports_as_a_constant_e() {
+    let dir = scratch("lossy");
+    let out = dir.join("out");
+    let r = run(&[
+        "export",
+        "--engine",
+        "constant-e",
+        "--material",
+        "nylon",
+        "--d-mm",
+        "10",
+        "--eta",
+        "3e4",
+        "--v-range",
+        "1,1e3",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let doc: serde_json::Value = serde_json::from_str(&read(&out, "export.json")).unwrap();
+    let pair = &doc["pairs"][0];
+    let e = pair["constant_e"]["e_mean"].as_f64().unwrap();
+    let alpha = pair["tsuji"]["alpha"].as_f64().unwrap();
+    // The closed form of Tsuji's overlap rule, exp(-pi a / sqrt(5 - a^2)), at the written
+    // alpha gives the written e (the solver's 1e-14 absolute error over e = 1.8e-5: 1e-9).
+    let closed = (-std::f64::consts::PI * alpha / (5.0 - alpha * alpha).sqrt()).exp();
+    assert!(
+        (closed / e - 1.0).abs() < 1e-8,
+        "{e} vs {closed} at alpha {alpha}"
+    );
+    assert!(e > 1e-5 && e < 1e-4, "{e}");
+
+    let out = dir.join("tiny");
+    let r = run(&[
+        "export",
+        "--engine",
+        "constant-e",
+        "--material",
+        "nylon",
+        "--d-mm",
+        "10",
+        "--eta",
+        "1e-300",
+        "--v-range",
+        "1e-3,1e3",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let svg = read(&out, "laws.svg");
+    assert!(svg.contains("η = 1e-300 kg/(s m)"), "{svg}");
+}

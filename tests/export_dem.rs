@@ -54,7 +54,8 @@ fn tsuji_overlap_rule_has_a_closed_form() {
     // linear y'' + alpha y' + (5/4) y = 0, and dy/dtau = (5/4) dx/dt; the overlap rule ends at
     // y = 0, half a damped period: e = exp(-pi alpha / sqrt(5 - alpha^2)) (docs/physics.md §9).
     // The solver does not know this; agreement to 1e-12 (RK4's error, measured <= 6e-13).
-    for alpha in [1e-6, 1e-3, 0.05, 0.2, 0.5, 1.0, 1.5, 2.0, 2.2] {
+    // Up to 2.18 (e = 1.1e-6): beyond, e falls below damped::E_MIN and is refused (tested below).
+    for alpha in [1e-6, 1e-3, 0.05, 0.2, 0.5, 1.0, 1.5, 2.0, 2.18] {
         let e = damped::restitution(alpha, Dashpot::Tsuji, ContactEnd::Overlap).unwrap();
         let exact = (-PI * alpha / (5.0 - alpha * alpha).sqrt()).exp();
         assert!((e - exact).abs() < 1e-12, "{alpha}: {e} vs {exact}");
@@ -304,4 +305,44 @@ fn scene_pairs_and_validation() {
     assert!(Scene::new(nylon(), vec![1e-3; 33], false).is_err());
     assert!(FittedCurve::new(ModelKind::Vm, vec![-1.0], ContactEnd::Overlap).is_err());
     assert!(FittedCurve::new(ModelKind::Min, vec![190.0], ContactEnd::Overlap).is_err());
+}
+
+#[test]
+fn tsuji_overlap_inversion_reaches_small_e_and_stops_at_critical_damping() {
+    // Tsuji's overlap rule is a damped oscillator in y = x^(5/4), critically damped at
+    // alpha = sqrt 5: every e in (0, 1) has its alpha below. The bracket had doubled past it to
+    // alpha = 2.8, where no rebound exists, so every e below about 0.08 failed (export of a
+    // lossy law as a constant e). Checked against the closed form e = exp(-pi a/sqrt(5 - a^2))
+    // (independent of the solver): measured worst 1.1e-8 relative at e = 1e-6, where the
+    // solver's absolute error of about 1e-14 is 1e-8 of e; bar 1e-7.
+    for e in [0.05, 0.01, 1e-3, 1e-4, 1e-5, damped::E_MIN] {
+        let a = alpha_for_e(e, Dashpot::Tsuji, ContactEnd::Overlap).unwrap();
+        assert!(a < damped::TSUJI_OVERLAP_CRITICAL, "{e}: {a}");
+        let exact = (-PI * a / (5.0 - a * a).sqrt()).exp();
+        assert!(
+            (exact / e - 1.0).abs() < 1e-7,
+            "{e}: alpha {a} gives {exact}"
+        );
+    }
+    // At and beyond critical damping the spheres never part: an error, not a number.
+    for a in [
+        damped::TSUJI_OVERLAP_CRITICAL,
+        2.5,
+        2.8256581771432048,
+        10.0,
+    ] {
+        let err = damped::restitution(a, Dashpot::Tsuji, ContactEnd::Overlap).unwrap_err();
+        assert!(err.to_string().contains("never part"), "{a}: {err}");
+    }
+    // Just below it e is below the solver's resolution (alpha = 2.2: e = 3e-8).
+    let err = damped::restitution(2.2, Dashpot::Tsuji, ContactEnd::Overlap).unwrap_err();
+    assert!(err.to_string().contains("e >= 5e-7"), "{err}");
+    // Below E_MIN the dashpot is all but critical and e has no relative accuracy left: e = 1e-20
+    // had been inverted to an alpha that gives 2.8e-16.
+    for e in [1e-7, 1e-20, 1e-300] {
+        for rule in ContactEnd::ALL {
+            let err = alpha_for_e(e, Dashpot::Tsuji, rule).unwrap_err();
+            assert!(err.to_string().contains("at least 1e-6"), "{e}: {err}");
+        }
+    }
 }

@@ -34,7 +34,8 @@
 //! This is deliberately a separate implementation from [`crate::models::viscoelastic`]: with
 //! q = 1/2 it must reproduce the master curve, which tests both (tests/export_dem.rs).
 //!
-//! **Needs** 0 <= alpha <= [`ALPHA_MAX`], finite. **Known answers**: alpha = 0 gives e = 1 and the
+//! **Needs** 0 <= alpha <= [`ALPHA_MAX`], finite (below sqrt 5 for Tsuji's overlap rule), and
+//! leaves e >= [`E_MIN`] / 2 (docs/physics.md §9.4). **Known answers**: alpha = 0 gives e = 1 and the
 //! Hertz contact time 3.2180654597190430845; for small alpha the dissipated work on the elastic
 //! trajectory gives 1 - e = alpha J_0 with J_0 = 2 int_0^x_max x^q p dx, which is
 //! 0.8 sqrt(5/4) B(1/2, 3/2) = pi/sqrt(5) for q = 1/4 and C1 = 1.1534488580952888 for q = 1/2.
@@ -74,9 +75,23 @@ impl Dashpot {
     }
 }
 
-/// Largest alpha accepted: e is then about 1e-3 (overlap rule, q = 1/4) and the slow unloading
-/// tail needs ever more steps; no DEM parameter of interest lies beyond.
+/// Largest alpha accepted: the force rule's e is then below 1e-3 (1e-3 at alpha = 35, q = 1/4)
+/// and the slow unloading tail needs ever more steps; no DEM parameter of interest lies beyond.
+/// Tsuji's dashpot under the overlap rule stops earlier, at [`TSUJI_OVERLAP_CRITICAL`].
 pub const ALPHA_MAX: f64 = 50.0;
+
+/// Tsuji's alpha from which the overlap rule has no rebound: y = x^(5/4) obeys
+/// y'' + alpha y' + (5/4) y = 0 (module note), critically damped at alpha = sqrt 5, and an
+/// overdamped y never returns to 0, so the spheres never part (e = 0).
+pub const TSUJI_OVERLAP_CRITICAL: f64 = 2.23606797749979;
+
+/// The smallest e the solver gives or inverts. Its e has an absolute error of about 1e-14 at
+/// the default steps (measured against the closed form of Tsuji's overlap rule: 2e-15 at
+/// e = 1e-10), so below 1e-6 it would carry more than 1e-8 of relative error, and Tsuji's
+/// overlap-rule alpha comes within 3% of critical damping, where e changes faster than a
+/// bisection in alpha resolves (e = 1e-20 had been inverted to an alpha that gives 2.8e-16).
+/// No DEM scene needs such an e: it is a sticking contact.
+pub const E_MIN: f64 = 1e-6;
 
 /// Runge-Kutta steps per phase by default. Measured against the master curve (q = 1/2, kappa up
 /// to 10, both rules): |error in e| <= 3e-13 at 2000 steps (tests/export_dem.rs).
@@ -144,18 +159,41 @@ fn locate(step: impl Fn(f64) -> Y, g: impl Fn(f64, &Y) -> f64) -> (f64, Y) {
     (hi, y_hi)
 }
 
-/// e of x'' = -x^(3/2) - alpha x^q x' (see the module note) with `steps` RK4 steps per phase.
+/// e of x'' = -x^(3/2) - alpha x^q x' (see the module note) with `steps` RK4 steps per phase;
+/// an error where e would be below half of [`E_MIN`] (the half: the alpha that
+/// [`alpha_for_e`] gives for E_MIN itself lands a bisection's width either side of it).
 pub fn rebound(
     alpha: f64,
     dashpot: Dashpot,
     rule: ContactEnd,
     steps: usize,
 ) -> Result<DampedRebound> {
+    let r = solve(alpha, dashpot, rule, steps)?;
+    if r.e < 0.5 * E_MIN {
+        return Err(Error::InvalidParameter {
+            name: "dimensionless damping alpha",
+            value: alpha,
+            expected: "one that leaves e >= 5e-7 (the solver's resolution; see damped::E_MIN)",
+        });
+    }
+    Ok(r)
+}
+
+/// [`rebound`] without the floor on e: [`alpha_for_e`]'s bisection passes below it.
+fn solve(alpha: f64, dashpot: Dashpot, rule: ContactEnd, steps: usize) -> Result<DampedRebound> {
     if !(alpha.is_finite() && (0.0..=ALPHA_MAX).contains(&alpha)) {
         return Err(Error::InvalidParameter {
             name: "dimensionless damping alpha",
             value: alpha,
             expected: "a number in [0, 50]",
+        });
+    }
+    if dashpot == Dashpot::Tsuji && rule == ContactEnd::Overlap && alpha >= TSUJI_OVERLAP_CRITICAL {
+        return Err(Error::InvalidParameter {
+            name: "dimensionless damping alpha (Tsuji's dashpot, overlap rule)",
+            value: alpha,
+            expected: "below sqrt 5 = 2.2360679...: from there on the contact is overdamped and \
+                       the spheres never part (e = 0)",
         });
     }
     let n = steps.max(16);
@@ -340,6 +378,14 @@ pub fn alpha_for_e(e: f64, dashpot: Dashpot, rule: ContactEnd) -> Result<f64> {
             expected: "a number in (0, 1]",
         });
     }
+    if e < E_MIN {
+        return Err(Error::InvalidParameter {
+            name: "restitution e",
+            value: e,
+            expected: "at least 1e-6 (below, the dashpot is all but critically damped and the \
+                       solver's e has no relative accuracy left; a DEM contact that sticks)",
+        });
+    }
     if e == 1.0 {
         return Ok(0.0);
     }
@@ -348,9 +394,19 @@ pub fn alpha_for_e(e: f64, dashpot: Dashpot, rule: ContactEnd) -> Result<f64> {
         Dashpot::Viscoelastic => 1.1534488580952888,
     };
     let target = e;
-    let one_minus =
-        |a: f64| -> Result<f64> { Ok(rebound(a, dashpot, rule, DEFAULT_STEPS)?.e - target) };
-    let guess = ((1.0 - e) / j0).min(ALPHA_MAX);
+    // Under the overlap rule Tsuji's e falls to 0 at alpha = sqrt 5 (TSUJI_OVERLAP_CRITICAL),
+    // so every e in (0, 1) has its alpha below: the bracket stops there (doubling past it had
+    // asked for a rebound that does not exist, and any e below about 0.08 failed).
+    let overdamped_from = (dashpot == Dashpot::Tsuji && rule == ContactEnd::Overlap)
+        .then_some(TSUJI_OVERLAP_CRITICAL);
+    let one_minus = |a: f64| -> Result<f64> {
+        if overdamped_from.is_some_and(|c| a >= c) {
+            return Ok(0.0 - target);
+        }
+        Ok(solve(a, dashpot, rule, DEFAULT_STEPS)?.e - target)
+    };
+    let cap = overdamped_from.unwrap_or(ALPHA_MAX);
+    let guess = ((1.0 - e) / j0).min(cap);
     let (mut lo, mut hi) = (guess, guess);
     let mut found = false;
     for _ in 0..200 {
@@ -364,14 +420,14 @@ pub fn alpha_for_e(e: f64, dashpot: Dashpot, rule: ContactEnd) -> Result<f64> {
         let f_hi = one_minus(hi)?;
         if f_hi > 0.0 {
             lo = hi;
-            if hi >= ALPHA_MAX {
+            if hi >= cap {
                 return Err(Error::InvalidParameter {
                     name: "restitution e",
                     value: e,
                     expected: "an e reachable with alpha <= 50",
                 });
             }
-            hi = (hi * 2.0).min(ALPHA_MAX);
+            hi = (hi * 2.0).min(cap);
             continue;
         }
         found = true;
