@@ -40,7 +40,7 @@
 //! trajectory gives 1 - e = alpha J_0 with J_0 = 2 int_0^x_max x^q p dx, which is
 //! 0.8 sqrt(5/4) B(1/2, 3/2) = pi/sqrt(5) for q = 1/4 and C1 = 1.1534488580952888 for q = 1/2.
 
-use crate::error::{Error, IntegrationFailure, Result};
+use crate::error::{Error, IntegrationFailure, Num, Result};
 use crate::models::viscoelastic::ContactEnd;
 
 /// The exponent q of the dashpot alpha x^q x'.
@@ -280,7 +280,7 @@ fn solve(alpha: f64, dashpot: Dashpot, rule: ContactEnd, steps: usize) -> Result
             return Err(fail(
                 alpha,
                 IntegrationFailure::NonFinite,
-                format!("non-finite state at t = {t}"),
+                format!("non-finite state at t = {}", Num(t)),
             ));
         }
         if rule == ContactEnd::Force && next[1] < 0.0 && g_t(&next) <= 0.0 {
@@ -309,7 +309,11 @@ fn solve(alpha: f64, dashpot: Dashpot, rule: ContactEnd, steps: usize) -> Result
                     return Err(fail(
                         alpha,
                         IntegrationFailure::Unphysical,
-                        format!("unphysical unloading state at s = {s}: p = {}", next[0]),
+                        format!(
+                            "unphysical unloading state at s = {}: p = {}",
+                            Num(s),
+                            Num(next[0])
+                        ),
                     ));
                 }
                 let s_next = if i + 1 == n { 0.0 } else { s + h_c };
@@ -343,7 +347,11 @@ fn solve(alpha: f64, dashpot: Dashpot, rule: ContactEnd, steps: usize) -> Result
         return Err(fail(
             alpha,
             IntegrationFailure::Unphysical,
-            format!("unphysical result: e = {e} from the speed, {e_energy} from the energy"),
+            format!(
+                "unphysical result: e = {} from the speed, {} from the energy",
+                Num(e),
+                Num(e_energy)
+            ),
         ));
     }
     let (e, one_minus_e) = if e_energy > 0.5 {
@@ -437,7 +445,7 @@ pub fn alpha_for_e(e: f64, dashpot: Dashpot, rule: ContactEnd) -> Result<f64> {
         return Err(fail(
             f64::NAN,
             IntegrationFailure::Other,
-            format!("could not bracket alpha for e = {e}"),
+            format!("could not bracket alpha for e = {}", Num(e)),
         ));
     }
     for _ in 0..200 {
@@ -458,6 +466,6 @@ pub fn alpha_for_e(e: f64, dashpot: Dashpot, rule: ContactEnd) -> Result<f64> {
     Err(fail(
         lo,
         IntegrationFailure::Other,
-        format!("bisection for e = {e} did not converge"),
+        format!("bisection for e = {} did not converge", Num(e)),
     ))
 }

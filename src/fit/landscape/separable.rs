@@ -436,10 +436,11 @@ impl Separable<'_> {
         };
         let error = if axis == 0 { ev.e_vm(i, x).err() } else { None };
         Err(match error {
-            Some(e) => format!("e_vm at eta = {x}: {e}"),
+            Some(e) => format!("e_vm at eta = {}: {e}", crate::error::Num(x)),
             None => format!(
-                "the model is NaN at {} = {x} for {}",
+                "the model is NaN at {} = {} for {}",
                 if axis == 0 { "eta" } else { "sigma_y" },
+                crate::error::Num(x),
                 self.obj.describe_point(i)
             ),
         })
