@@ -44,11 +44,34 @@ fn draw(points: &[StudyPoint], title: &str) -> Result<String, PlotFailure> {
             "no measurable point in the camera study".into(),
         ));
     };
+    // What the panels leave out, said under them: a field of view of 1e-6 m leaves two frames
+    // per phase, free fits then measure nothing, and their lines had vanished without a word.
+    let mut notes = Vec::new();
+    for (fit, name) in [
+        ("free", "free quadratic"),
+        ("fixed_gravity", "fixed-gravity"),
+    ] {
+        if !points.iter().any(|p| p.fit == fit && ok(&p)) {
+            notes.push(format!(
+                "No {name} fit line: fewer than 2 collisions measured at every speed."
+            ));
+        }
+    }
+    let left_out = points.iter().filter(|p| !ok(p)).count();
+    if left_out > 0 {
+        notes.push(format!(
+            "{left_out} of {} camera, fit and speed points left out: fewer than 2 collisions \
+             measured (camera_study.csv counts them).",
+            points.len()
+        ));
+    }
     let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (1300, 620)).into_drawing_area();
+        let height = 620 + 26 * notes.len() as u32 + if notes.is_empty() { 0 } else { 10 };
+        let root = SVGBackend::with_string(&mut svg, (1300, height)).into_drawing_area();
         let e = |e: DrawingAreaErrorKind<_>| PlotFailure::backend(e);
         root.fill(&WHITE).map_err(e)?;
+        let (root, footer) = root.split_vertically(620);
         let root = root.titled(title, ("sans-serif", 26)).map_err(e)?;
         let (left, right) = root.split_horizontally(650);
         let x_range = (v_axis.0..v_axis.1).log_scale();
@@ -75,6 +98,8 @@ fn draw(points: &[StudyPoint], title: &str) -> Result<String, PlotFailure> {
         bias.configure_mesh()
             .x_desc("normal impact speed v_n (m/s)")
             .y_desc("bias of e_measured / e_true (%)")
+            // Ticks land a rounding away from 0 and had printed "-0.0".
+            .y_label_formatter(&|v| format!("{:.1}", if v.abs() < 1e-9 { 0.0 } else { *v }))
             .axis_desc_style(("sans-serif", 22))
             .label_style(("sans-serif", 18))
             .draw()
@@ -146,6 +171,15 @@ fn draw(points: &[StudyPoint], title: &str) -> Result<String, PlotFailure> {
                     + PathElement::new([(22, 0), (26, 0)], BLACK.stroke_width(2))
             });
         super::legend(&mut scatter, SeriesLabelPosition::UpperRight, 17)?;
+        for (k, note) in notes.iter().enumerate() {
+            footer
+                .draw(&Text::new(
+                    note.clone(),
+                    (20, 6 + 26 * k as i32),
+                    ("sans-serif", 18).into_font(),
+                ))
+                .map_err(e)?;
+        }
         root.present().map_err(e)?;
     }
     Ok(svg)
