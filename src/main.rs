@@ -74,10 +74,20 @@ fn main() -> ExitCode {
                     ExitCode::SUCCESS
                 }
                 _ => {
-                    // One line: clap's first line names the flag and the value.
+                    // One line: clap's first line names the flag and the value, or ends in
+                    // a colon with the names on the indented lines below (missing arguments:
+                    // their names had been cut off).
                     let text = e.render().to_string();
-                    let first = text.lines().next().unwrap_or("invalid arguments");
-                    let first = first.strip_prefix("error: ").unwrap_or(first);
+                    let mut lines = text.lines();
+                    let first = lines.next().unwrap_or("invalid arguments");
+                    let mut first = first.strip_prefix("error: ").unwrap_or(first).to_string();
+                    if first.ends_with(':') {
+                        let names: Vec<&str> = lines
+                            .take_while(|l| l.starts_with("  "))
+                            .map(str::trim)
+                            .collect();
+                        first = format!("{first} {}", names.join(", "));
+                    }
                     error_line(format_args!("{first} (see --help)"));
                     ExitCode::from(2)
                 }

@@ -41,7 +41,7 @@ pub struct Args {
     #[arg(long, value_name = "DIR")]
     out: PathBuf,
     /// Number of collisions (at most 2000)
-    #[arg(long, default_value_t = 60)]
+    #[arg(long, default_value_t = 60, conflicts_with = "camera_study")]
     n: usize,
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -70,8 +70,9 @@ pub struct Args {
     /// Walton's limiting tangential restitution
     #[arg(long, default_value_t = 0.5)]
     beta0: f64,
-    /// Range of the normal impact speed, m/s (log-uniform)
-    #[arg(long = "v-n-m-s", value_delimiter = ',', default_values_t = [0.5, 5.0])]
+    /// Range of the normal impact speed, m/s (log-uniform; the camera study has its own speeds)
+    #[arg(long = "v-n-m-s", value_delimiter = ',', default_values_t = [0.5, 5.0],
+          conflicts_with = "camera_study")]
     v_n_m_s: Vec<f64>,
     /// Range of the angle of incidence, degrees (0 = head-on)
     #[arg(long = "incidence-deg", value_delimiter = ',', default_values_t = [0.0, 80.0])]
@@ -103,7 +104,7 @@ pub struct Args {
     #[arg(long = "camera-study")]
     camera_study: bool,
     /// Collisions per camera and speed in the camera study (at most 500)
-    #[arg(long = "study-n", default_value_t = 200)]
+    #[arg(long = "study-n", default_value_t = 200, requires = "camera_study")]
     study_n: usize,
     #[command(flatten)]
     render: Box<super::frames_out::FramesArgs>,
