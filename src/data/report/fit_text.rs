@@ -381,11 +381,13 @@ fn note_lines(set: &FitSet) -> Vec<String> {
             };
             out.push(format!(
                 "{}: global minimum certified: no chi2 below it by more than {} {region} ({} \
-                 cells, {} polishes)",
+                 cell{}, {} polish{})",
                 f.model.name(),
                 short(g.gap_chi2, 2),
                 g.cells,
-                g.polishes
+                if g.cells == 1 { "" } else { "s" },
+                g.polishes,
+                if g.polishes == 1 { "" } else { "es" }
             ));
         }
         if f.model == ModelKind::PowerLaw {
