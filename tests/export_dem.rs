@@ -346,3 +346,20 @@ fn tsuji_overlap_inversion_reaches_small_e_and_stops_at_critical_damping() {
         }
     }
 }
+
+#[test]
+fn the_closest_viscoelastic_law_says_when_it_is_the_end_of_its_search() {
+    // sigma_y = 1e12 Pa: nothing yields (V_Y is 1e9 times the range), so the plastic curve is
+    // e = 1 exactly and the closest viscoelastic law is eta -> 0, which the search cannot reach:
+    // its eta is the search's floor (kappa = 1e-7) and it says so; it had been reported as the
+    // minimising eta. The ordinary case (the paper's sigma_y) is an interior minimum.
+    let pairs = [pair(10.0, 10.0)];
+    let r = SpeedRange::new(0.5, 40.0).unwrap();
+    let elastic = FittedCurve::new(ModelKind::Pm, vec![1e12], ContactEnd::Overlap).unwrap();
+    let f = law::viscoelastic_fit(&elastic, &pairs, &r, Weight::LogUniform).unwrap();
+    assert_eq!(f.search_end, Some(law::SearchEnd::Lower), "{f:?}");
+    assert!(f.dev_mean < 1e-6, "{f:?}");
+    let paper = FittedCurve::new(ModelKind::Pm, vec![4e7], ContactEnd::Overlap).unwrap();
+    let f = law::viscoelastic_fit(&paper, &pairs, &r, Weight::LogUniform).unwrap();
+    assert_eq!(f.search_end, None, "{f:?}");
+}

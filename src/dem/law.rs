@@ -181,6 +181,29 @@ pub struct ViscoelasticFit {
     pub exact: bool,
     /// Both minimisations met their tolerance.
     pub converged: bool,
+    /// Where a minimisation ended at an end of its search in eta (see [`SearchEnd`]): its eta is
+    /// then that end, not a minimum.
+    pub search_end: Option<SearchEnd>,
+}
+
+/// An end of [`viscoelastic_fit`]'s search in eta.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SearchEnd {
+    /// kappa = 1e-7 at the most damped point: the fitted e(v) is elastic to about that level
+    /// over the range, and a smaller eta may be closer still (eta = 0 is no law to export).
+    Lower,
+    /// kappa = 30 at the least damped point (or 100 anywhere): e is ~1e-7 there; the fitted
+    /// e(v) is so lossy that a larger eta may be closer still.
+    Upper,
+}
+
+impl SearchEnd {
+    pub fn name(self) -> &'static str {
+        match self {
+            SearchEnd::Lower => "lower",
+            SearchEnd::Upper => "upper",
+        }
+    }
 }
 
 /// Grid points in ln eta before the Brent polish.
@@ -221,6 +244,7 @@ pub fn viscoelastic_fit(
             dev_mean_per_pair: vec![0.0; pairs.len()],
             exact: true,
             converged: true,
+            search_end: None,
         });
     }
     // Fitted e cached at the nodes of each pair.
@@ -275,6 +299,7 @@ pub fn viscoelastic_fit(
         (30.0 / k_min).min(KAPPA_MAX / k_max).ln(),
     );
     let mut converged = true;
+    let mut search_end = None;
     let mut minimise = |f: &dyn Fn(f64) -> Result<f64>| -> Result<f64> {
         let grid: Vec<f64> = (0..ETA_SCAN)
             .map(|i| a + (b - a) * i as f64 / (ETA_SCAN - 1) as f64)
@@ -290,7 +315,14 @@ pub fn viscoelastic_fit(
         let hi = grid[(best.0 + 1).min(ETA_SCAN - 1)];
         let m = brent_minimize(f, lo, hi, 1e-12)?;
         converged &= m.converged;
-        Ok(if m.fx <= best.1 { m.x } else { grid[best.0] })
+        let x = if m.fx <= best.1 { m.x } else { grid[best.0] };
+        // Brent's tolerance in ln eta is 1.5e-8: within a hundred of it of an end is that end.
+        if x - a < 1e-6 {
+            search_end = Some(SearchEnd::Lower);
+        } else if b - x < 1e-6 {
+            search_end = Some(SearchEnd::Upper);
+        }
+        Ok(x)
     };
     let eta_mean = minimise(&ls)?.exp();
     let eta_minimax = minimise(&mm)?.exp();
@@ -322,6 +354,7 @@ pub fn viscoelastic_fit(
         dev_mean_per_pair,
         exact: false,
         converged,
+        search_end,
     })
 }
 

@@ -338,6 +338,7 @@ pub fn export_json(s: &Summary) -> String {
             "eta_mean": num(vm.eta_mean), "max_dev_mean": num(vm.dev_mean),
             "eta_minimax": num(vm.eta_minimax), "max_dev_minimax": num(vm.dev_minimax),
             "converged": vm.converged,
+            "search_end": vm.search_end.map(|e| e.name()),
         },
         "pairs": pairs,
         "files": s.files,

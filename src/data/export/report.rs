@@ -3,7 +3,7 @@
 
 use super::files::{Summary, sig};
 use crate::data::fmt_num;
-use crate::dem::law::LawKind;
+use crate::dem::law::{LawKind, SearchEnd};
 use crate::fit::models::unit_after;
 use std::fmt::Write as _;
 
@@ -85,6 +85,23 @@ pub fn report(s: &Summary) -> String {
             sig(vm.eta_minimax, 5),
             sig(vm.dev_minimax, 3)
         );
+        match vm.search_end {
+            Some(SearchEnd::Lower) => {
+                let _ = writeln!(
+                    o,
+                    "               (eta at the lower end of its search, kappa = 1e-7: the fitted \
+                     e(v) is elastic to that level, and a smaller eta may be closer still)"
+                );
+            }
+            Some(SearchEnd::Upper) => {
+                let _ = writeln!(
+                    o,
+                    "               (eta at the upper end of its search, e ~ 1e-7 where least \
+                     damped: a larger eta may be closer still)"
+                );
+            }
+            None => {}
+        }
     }
     if let Some(t) = &tr.table {
         let _ = writeln!(
