@@ -283,3 +283,46 @@ fn a_bad_frame_is_a_warning_or_with_strict_an_error() {
     ]);
     assert_fails_naming(&r, "frame0112.png", &out2);
 }
+
+/// A spin from one frame pair has no scatter to give it an error: the table had printed it
+/// bare ("from 1 frame pairs"), like a value without uncertainty; it now says the error is
+/// unknown. (The virtual experiment's first collision at its default seed: a frame with three
+/// blobs leaves sphere 1 one frame pair before the collision.)
+#[test]
+fn a_spin_from_one_frame_pair_says_its_error_is_unknown() {
+    let dir = scratch("one-pair");
+    let (sim, fr) = (dir.join("sim"), dir.join("fr"));
+    let r = run(&[
+        "simulate",
+        "--material",
+        "nylon",
+        "--out",
+        &s(&sim),
+        "--n",
+        "2",
+        "--d-mm",
+        "12.7",
+        "--frames-out",
+        &s(&fr),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let r = run(&[
+        "track",
+        &s(&fr.join("c1")),
+        "--fps",
+        "1000",
+        "--d-mm",
+        "12.7",
+    ]);
+    assert!(r.ok, "{}", r.stderr);
+    let line = r
+        .stdout
+        .lines()
+        .find(|l| l.starts_with("sphere 1 before:"))
+        .expect("a spin line");
+    assert!(
+        line.ends_with("rad/s (error unknown: one pair has no scatter) from 1 frame pair"),
+        "{line}"
+    );
+    assert!(!r.stdout.contains("frame pairs (") && !r.stdout.contains("1 frame pairs"));
+}

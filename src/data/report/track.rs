@@ -90,10 +90,11 @@ pub fn to_table(results: &[CollisionResult]) -> String {
                         err_rad_s,
                         pairs,
                     } => format!(
-                        "w = ({}, {}, {}) rad/s{} from {pairs} frame pairs",
+                        "w = ({}, {}, {}) rad/s{} from {}",
                         readable(w_rad_s[0]),
                         readable(w_rad_s[1]),
                         readable(w_rad_s[2]),
+                        // One pair has no scatter to give an error: said, not left blank.
                         err_rad_s
                             .map(|e| format!(
                                 " +- ({}, {}, {})",
@@ -101,13 +102,15 @@ pub fn to_table(results: &[CollisionResult]) -> String {
                                 readable(e[1]),
                                 readable(e[2])
                             ))
-                            .unwrap_or_default()
+                            .unwrap_or_else(|| " (error unknown: one pair has no scatter)".into()),
+                        frame_pairs(*pairs)
                     ),
                     Spin::ZOnly {
                         wz_rad_s, pairs, ..
                     } => format!(
-                        "w_z = {} rad/s from {pairs} frame pairs (one marker: assumes the axis is the camera axis)",
-                        readable(*wz_rad_s)
+                        "w_z = {} rad/s from {} (one marker: assumes the axis is the camera axis)",
+                        readable(*wz_rad_s),
+                        frame_pairs(*pairs)
                     ),
                     Spin::None { reason } => format!("no spin: {reason}"),
                 };
@@ -117,4 +120,8 @@ pub fn to_table(results: &[CollisionResult]) -> String {
         let _ = writeln!(out);
     }
     out
+}
+
+fn frame_pairs(n: usize) -> String {
+    format!("{n} frame pair{}", if n == 1 { "" } else { "s" })
 }
