@@ -844,23 +844,27 @@ fn a_file_of_one_fit_exports_it() {
 #[test]
 fn a_lossy_law_exports_as_a_constant_e() {
     let dir = scratch("lossy");
+    // A constant-e export of 10 mm nylon spheres with damping `eta` over `v_range`.
+    let export = |eta: &str, v_range: &str, out: &Path| {
+        let r = run(&[
+            "export",
+            "--engine",
+            "constant-e",
+            "--material",
+            "nylon",
+            "--d-mm",
+            "10",
+            "--eta",
+            eta,
+            "--v-range",
+            v_range,
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(r.ok, "{}", r.stderr);
+    };
     let out = dir.join("out");
-    let r = run(&[
-        "export",
-        "--engine",
-        "constant-e",
-        "--material",
-        "nylon",
-        "--d-mm",
-        "10",
-        "--eta",
-        "3e4",
-        "--v-range",
-        "1,1e3",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(r.ok, "{}", r.stderr);
+    export("3e4", "1,1e3", &out);
     let doc: serde_json::Value = serde_json::from_str(&read(&out, "export.json")).unwrap();
     let pair = &doc["pairs"][0];
     let e = pair["constant_e"]["e_mean"].as_f64().unwrap();
@@ -875,22 +879,7 @@ fn a_lossy_law_exports_as_a_constant_e() {
     assert!(e > 1e-5 && e < 1e-4, "{e}");
 
     let out = dir.join("tiny");
-    let r = run(&[
-        "export",
-        "--engine",
-        "constant-e",
-        "--material",
-        "nylon",
-        "--d-mm",
-        "10",
-        "--eta",
-        "1e-300",
-        "--v-range",
-        "1e-3,1e3",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(r.ok, "{}", r.stderr);
+    export("1e-300", "1e-3,1e3", &out);
     let svg = read(&out, "laws.svg");
     assert!(svg.contains("η = 1e-300 kg/(s m)"), "{svg}");
 }
