@@ -315,6 +315,7 @@ fn tsuji_overlap_inversion_reaches_small_e_and_stops_at_critical_damping() {
     // lossy law as a constant e). Checked against the closed form e = exp(-pi a/sqrt(5 - a^2))
     // (independent of the solver): measured worst 1.1e-8 relative at e = 1e-6, where the
     // solver's absolute error of about 1e-14 is 1e-8 of e; bar 1e-7.
+    assert_eq!(damped::TSUJI_OVERLAP_CRITICAL, 5f64.sqrt());
     for e in [0.05, 0.01, 1e-3, 1e-4, 1e-5, damped::E_MIN] {
         let a = alpha_for_e(e, Dashpot::Tsuji, ContactEnd::Overlap).unwrap();
         assert!(a < damped::TSUJI_OVERLAP_CRITICAL, "{e}: {a}");

@@ -35,8 +35,8 @@
 //! q = 1/2 it must reproduce the master curve, which tests both (tests/export_dem.rs).
 //!
 //! **Needs** 0 <= alpha <= [`ALPHA_MAX`], finite (below sqrt 5 for Tsuji's overlap rule), and
-//! leaves e >= [`E_MIN`] / 2 (docs/physics.md §9.4). **Known answers**: alpha = 0 gives e = 1 and the
-//! Hertz contact time 3.2180654597190430845; for small alpha the dissipated work on the elastic
+//! leaves e >= [`E_MIN`] / 2 (docs/physics.md §9.4). **Known answers**: alpha = 0 gives e = 1
+//! and the Hertz contact time 3.2180654597190430845; for small alpha the dissipated work on the elastic
 //! trajectory gives 1 - e = alpha J_0 with J_0 = 2 int_0^x_max x^q p dx, which is
 //! 0.8 sqrt(5/4) B(1/2, 3/2) = pi/sqrt(5) for q = 1/4 and C1 = 1.1534488580952888 for q = 1/2.
 

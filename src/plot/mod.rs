@@ -28,7 +28,7 @@ pub fn colour(i: usize) -> RGBColor {
 /// 0.9200000000000002 or 1.000e-5, and a legend's eta 2236, not 2236.423.
 pub fn short(x: f64) -> String {
     let rounded: f64 = format!("{x:.3e}").parse().unwrap_or(x);
-    if (1e-3..1e6).contains(&rounded.abs()) {
+    if rounded == 0.0 || (1e-3..1e6).contains(&rounded.abs()) {
         format!("{rounded}")
     } else {
         format!("{rounded:e}")
