@@ -837,15 +837,31 @@ fn a_file_of_one_fit_exports_it() {
 }
 
 /// A lossy law as a constant e: eta = 3e4 kg/(s m) on 10 mm nylon spheres gives e from 1.2e-4
-/// at 1 m/s down to 1.2e-7; its mean e (1.8e-5) needs Tsuji's alpha = 2.149, close to critical
-/// damping (sqrt 5 = 2.236). The inversion had doubled its bracket past sqrt 5 and the export
-/// failed with "unphysical unloading state ... p = 0.0000000000000111...". Its laws.svg labels
-/// eta in short form (1e-300 had read 0.0000).
+/// at 1 m/s down to 1.2e-7 (mean 1.8e-5). The export had failed with "unphysical unloading
+/// state ... p = 0.0000000000000111..." (Tsuji's inversion doubled its bracket past critical
+/// damping); with that fixed it wrote `damping tsuji` coefficient 1, an all but elastic contact,
+/// because LAMMPS's polynomial cannot damp that much (at most alpha = 1.2728, which gives
+/// e = 0.1136 under the overlap rule, 0.2628 under the force rule: the closed form
+/// exp(-pi a/sqrt(5 - a^2)) gives the first). Now one error line naming the pair, the e and
+/// the floor, and no files. laws.svg labels eta in short form (1e-300 had read 0.0000).
 #[test]
-fn a_lossy_law_exports_as_a_constant_e() {
+fn a_constant_e_out_of_lammpss_reach_is_an_error_not_an_elastic_contact() {
     let dir = scratch("lossy");
-    // A constant-e export of 10 mm nylon spheres with damping `eta` over `v_range`.
-    let export = |eta: &str, v_range: &str, out: &Path| {
+    let floor = (-std::f64::consts::PI * 1.2728 / (5.0f64 - 1.2728 * 1.2728).sqrt()).exp();
+    assert_eq!(format!("{floor:.4}"), "0.1136");
+    for (rule, says) in [
+        (
+            "overlap",
+            "pair 1-1: a constant e of 1.801e-5 is out of reach of LAMMPS's damping \
+                     tsuji (the most damping its input can ask for gives e = 0.1136)",
+        ),
+        (
+            "force",
+            "pair 1-1: a constant e of 0.01352 is out of reach of LAMMPS's damping tsuji \
+                   (the most damping its input can ask for gives e = 0.2628)",
+        ),
+    ] {
+        let out = dir.join(rule);
         let r = run(&[
             "export",
             "--engine",
@@ -855,31 +871,36 @@ fn a_lossy_law_exports_as_a_constant_e() {
             "--d-mm",
             "10",
             "--eta",
-            eta,
+            "3e4",
             "--v-range",
-            v_range,
+            "1,1e3",
+            "--contact-end",
+            rule,
             "--out",
             out.to_str().unwrap(),
         ]);
-        assert!(r.ok, "{}", r.stderr);
-    };
-    let out = dir.join("out");
-    export("3e4", "1,1e3", &out);
-    let doc: serde_json::Value = serde_json::from_str(&read(&out, "export.json")).unwrap();
-    let pair = &doc["pairs"][0];
-    let e = pair["constant_e"]["e_mean"].as_f64().unwrap();
-    let alpha = pair["tsuji"]["alpha"].as_f64().unwrap();
-    // The closed form of Tsuji's overlap rule, exp(-pi a / sqrt(5 - a^2)), at the written
-    // alpha gives the written e (the solver's 1e-14 absolute error over e = 1.8e-5: 1e-9).
-    let closed = (-std::f64::consts::PI * alpha / (5.0 - alpha * alpha).sqrt()).exp();
-    assert!(
-        (closed / e - 1.0).abs() < 1e-8,
-        "{e} vs {closed} at alpha {alpha}"
-    );
-    assert!(e > 1e-5 && e < 1e-4, "{e}");
-
+        assert!(!r.ok);
+        assert!(r.stderr.contains(says), "{}", r.stderr);
+        assert_eq!(r.stderr.lines().count(), 1, "{}", r.stderr);
+        assert!(!out.exists());
+    }
     let out = dir.join("tiny");
-    export("1e-300", "1e-3,1e3", &out);
+    let r = run(&[
+        "export",
+        "--engine",
+        "constant-e",
+        "--material",
+        "nylon",
+        "--d-mm",
+        "10",
+        "--eta",
+        "1e-300",
+        "--v-range",
+        "1e-3,1e3",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.ok, "{}", r.stderr);
     let svg = read(&out, "laws.svg");
     assert!(svg.contains("η = 1e-300 kg/(s m)"), "{svg}");
 }

@@ -29,6 +29,21 @@ pub enum FilesFailure {
         kappa: f64,
         eta: f64,
     },
+    /// A pair's constant e lies beyond what an engine's damping input can ask for: writing the
+    /// nearest input would give another e without a word (LAMMPS's `damping tsuji` polynomial
+    /// damps at most alpha = 1.2728; LIGGGHTS's formula with limitForce on reaches no e below
+    /// its value at critical damping).
+    #[error(
+        "pair {pair}: a constant e of {} is out of reach of {engine} (the most damping its input can ask for gives e = {}); use --engine table, or --engine lammps with the viscoelastic law",
+        crate::data::significant(*e, 4),
+        crate::data::significant(*e_floor, 4)
+    )]
+    OutOfReach {
+        pair: String,
+        engine: &'static str,
+        e: f64,
+        e_floor: f64,
+    },
     /// The toolkit could not predict collide.in's collisions.
     #[error("cannot predict the collisions: {0}")]
     Collisions(crate::error::Error),

@@ -172,10 +172,7 @@ pub fn liggghts_input(
         }
     }
     if missing {
-        let _ = writeln!(
-            s,
-            "# Entries 1 (wall-wall, or an e out of reach of LIGGGHTS's formula) take no part in the scene."
-        );
+        let _ = writeln!(s, "# Entries 1 (wall-wall) take no part in the scene.");
     }
     let _ = writeln!(
         s,

@@ -5,6 +5,8 @@ use super::FilesFailure;
 use super::files::{self, Summary};
 use super::lammps::{self, Friction, LammpsFiles, LammpsLaw};
 use crate::data::fmt_num;
+use crate::dem::damped::{self, Dashpot};
+use crate::dem::engines::lammps_tsuji_alpha;
 use crate::dem::range::SpeedRange;
 use crate::dem::translate::{ConstantEInputs, Translation, constant_e_inputs};
 
@@ -75,14 +77,34 @@ pub fn plan(
         ),
         _ => None,
     };
+    // LAMMPS's `damping tsuji` coefficient per pair, or why a pair's e is out of its reach.
+    // The polynomial cannot ask for less damping than at cor = 1 (e above 0.99958): then cor = 1,
+    // and collide.in's expected e says what LAMMPS gives instead. Nor for more than at cor = 0
+    // (alpha = 1.2728; e = 0.114 under the overlap rule): writing cor = 1 there, as before, made
+    // a lossy pair all but elastic without a word, so it is an error.
+    let lammps_cor = |inputs: &[ConstantEInputs]| -> Result<Vec<f64>, FilesFailure> {
+        inputs
+            .iter()
+            .zip(&tr.pairs)
+            .map(|(i, pair)| match i.lammps_cor {
+                Some(c) => Ok(c),
+                None if i.alpha < lammps_tsuji_alpha(0.0) => Ok(1.0),
+                None => Err(FilesFailure::OutOfReach {
+                    pair: pair.label(),
+                    engine: "LAMMPS's damping tsuji",
+                    e: i.e,
+                    e_floor: damped::restitution(lammps_tsuji_alpha(0.0), Dashpot::Tsuji, rule)
+                        .map_err(FilesFailure::ConstantE)?,
+                }),
+            })
+            .collect()
+    };
     let tsuji_law = |note: String| -> Result<LammpsLaw, FilesFailure> {
         let inputs = const_inputs.as_ref().ok_or(FilesFailure::NeedsSpeedRange(
             "a constant e needs the scene's speeds (--v-range)",
         ))?;
         Ok(LammpsLaw::Tsuji {
-            // The polynomial cannot ask for less damping than at cor = 1 (e above 0.99958):
-            // then cor = 1, and collide.in's expected e says what LAMMPS gives instead.
-            cor: inputs.iter().map(|i| i.lammps_cor.unwrap_or(1.0)).collect(),
+            cor: lammps_cor(inputs)?,
             note,
         })
     };
@@ -103,7 +125,14 @@ pub fn plan(
             let use_const = match law {
                 LawChoice::Viscoelastic => false,
                 LawChoice::ConstantE => true,
-                LawChoice::Auto => !vm.exact && const_dev.is_some_and(|d| d < vm.dev_mean),
+                // A constant e LAMMPS cannot give is no candidate.
+                LawChoice::Auto => {
+                    !vm.exact
+                        && const_dev.is_some_and(|d| d < vm.dev_mean)
+                        && const_inputs
+                            .as_deref()
+                            .is_some_and(|i| lammps_cor(i).is_ok())
+                }
             };
             Some(if use_const {
                 tsuji_law(format!(
@@ -154,6 +183,24 @@ pub fn plan(
         None
     };
     if let Some(inputs) = &constant_inputs {
+        // LIGGGHTS's formula cannot ask for more than critical damping (alpha = sqrt 5): with
+        // limitForce on, e below its value there is out of reach (the file had written 1 for
+        // such a pair, an elastic contact, saying such entries take no part in the scene).
+        for (i, pair) in inputs.iter().zip(&tr.pairs) {
+            if i.liggghts_e.is_none() {
+                return Err(FilesFailure::OutOfReach {
+                    pair: pair.label(),
+                    engine: "LIGGGHTS's Hertz model with limitForce on",
+                    e: i.e,
+                    e_floor: damped::restitution(
+                        damped::TSUJI_OVERLAP_CRITICAL,
+                        Dashpot::Tsuji,
+                        rule,
+                    )
+                    .map_err(FilesFailure::ConstantE)?,
+                });
+            }
+        }
         outputs.push((
             "constant_e.csv".into(),
             files::constant_e_csv(tr, inputs)?.into_bytes(),
