@@ -49,7 +49,8 @@ pub enum Engine {
 
 #[derive(clap::ValueEnum, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum LawArg {
-    /// The exact law for vm, otherwise whichever of the other two is closer to the fit
+    /// The exact law for vm, otherwise whichever of the other two is closer to the fit (a
+    /// constant e only where LAMMPS's damping tsuji can give it)
     Auto,
     Viscoelastic,
     ConstantE,

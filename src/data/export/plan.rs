@@ -122,16 +122,15 @@ pub fn plan(
                 .constant
                 .as_ref()
                 .map(|c| c.iter().map(|x| x.dev_mean).fold(0.0, f64::max));
+            let const_reachable = const_inputs
+                .as_deref()
+                .is_some_and(|i| lammps_cor(i).is_ok());
             let use_const = match law {
                 LawChoice::Viscoelastic => false,
                 LawChoice::ConstantE => true,
                 // A constant e LAMMPS cannot give is no candidate.
                 LawChoice::Auto => {
-                    !vm.exact
-                        && const_dev.is_some_and(|d| d < vm.dev_mean)
-                        && const_inputs
-                            .as_deref()
-                            .is_some_and(|i| lammps_cor(i).is_ok())
+                    !vm.exact && const_dev.is_some_and(|d| d < vm.dev_mean) && const_reachable
                 }
             };
             Some(if use_const {
@@ -158,7 +157,14 @@ pub fn plan(
                         fmt_num(vm.eta_mean),
                         vm.dev_mean,
                         const_dev
-                            .map(|d| format!("; a constant e would deviate by {d:.3e}"))
+                            .map(|d| format!(
+                                "; a constant e would deviate by {d:.3e}{}",
+                                if const_reachable {
+                                    ""
+                                } else {
+                                    " but is out of reach of LAMMPS's damping tsuji"
+                                }
+                            ))
                             .unwrap_or_default()
                     ),
                 }
