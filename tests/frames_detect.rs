@@ -254,7 +254,10 @@ fn three_blobs_or_none_are_errors() {
         ],
     );
     let e = detect_frame(&sc.render(), &DetectSettings::default()).unwrap_err();
-    assert!(matches!(e, DetectError::TooManyBlobs { n: 3 }), "{e}");
+    assert!(
+        matches!(e, DetectError::TooManyBlobs { n: 3, at_edge: 0 }),
+        "{e}"
+    );
     let sc = Scene::paper_like(192, 239, vec![]);
     let e = detect_frame(&sc.render(), &DetectSettings::default()).unwrap_err();
     assert!(e.to_string().starts_with("no sphere"), "{e}");

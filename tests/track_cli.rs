@@ -286,8 +286,9 @@ fn a_bad_frame_is_a_warning_or_with_strict_an_error() {
 
 /// A spin from one frame pair has no scatter to give it an error: the table had printed it
 /// bare ("from 1 frame pairs"), like a value without uncertainty; it now says the error is
-/// unknown. (The virtual experiment's first collision at its default seed: a frame with three
-/// blobs leaves sphere 1 one frame pair before the collision.)
+/// unknown. (The virtual experiment's first collision at its default seed: sphere 1 has one
+/// frame pair before the collision; the last frame, with three blobs, is left out, and its
+/// warning names the edge.)
 #[test]
 fn a_spin_from_one_frame_pair_says_its_error_is_unknown() {
     let dir = scratch("one-pair");
@@ -325,4 +326,14 @@ fn a_spin_from_one_frame_pair_says_its_error_is_unknown() {
         "{line}"
     );
     assert!(!r.stdout.contains("frame pairs (") && !r.stdout.contains("1 frame pairs"));
+    // The last frame's warning says where its third blob comes from: both spheres are leaving
+    // the view, and a marker at the edge splits one of them.
+    assert!(
+        r.stderr.contains(
+            "frame_000010.png: 3 sphere-sized blobs where at most 2 spheres were expected (3 of \
+             them cut by the frame's edge, where a sphere leaving the view can split in two)"
+        ),
+        "{}",
+        r.stderr
+    );
 }

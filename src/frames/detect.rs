@@ -72,9 +72,17 @@ pub struct FrameDetection {
 pub enum DetectError {
     #[error("{0}")]
     Coarse(CoarseError),
-    /// More than two sphere-sized blobs (or maxima): not a two-sphere frame.
-    #[error("{n} sphere-sized blobs where at most 2 spheres were expected")]
-    TooManyBlobs { n: usize },
+    /// More than two sphere-sized blobs (or maxima): not a two-sphere frame. `at_edge` of them
+    /// touch the image border, where a sphere leaving the view can be cut into two by a marker.
+    #[error(
+        "{n} sphere-sized blobs where at most 2 spheres were expected{}",
+        if *at_edge > 0 {
+            format!(" ({at_edge} of them cut by the frame's edge, where a sphere leaving the view can split in two)")
+        } else {
+            String::new()
+        }
+    )]
+    TooManyBlobs { n: usize, at_edge: usize },
     /// Seeds were found but no circle could be fitted to any.
     #[error("no sphere could be fitted: {}", reasons.join("; "))]
     NoFit { reasons: Vec<String> },
@@ -217,7 +225,10 @@ fn fit_points(
 pub fn detect_frame(img: &GrayImage, s: &DetectSettings) -> Result<FrameDetection, DetectError> {
     let co: Coarse = coarse(img, s.max_coarse_pixels).map_err(DetectError::Coarse)?;
     if co.seeds.len() > 2 {
-        return Err(DetectError::TooManyBlobs { n: co.seeds.len() });
+        return Err(DetectError::TooManyBlobs {
+            n: co.seeds.len(),
+            at_edge: co.seeds.iter().filter(|s| s.touches_border).count(),
+        });
     }
     let kernel = derivative_kernel(&s.profile);
     // Gradient noise: the profile averages 3 rays (sigma/sqrt 3); the kernel's noise gain is
