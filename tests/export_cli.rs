@@ -836,6 +836,15 @@ fn a_file_of_one_fit_exports_it() {
     );
 }
 
+/// `export` of a law given as numbers for 10 mm nylon spheres: `args` (engine, law, range)
+/// then `--out out`.
+fn export_nylon_10mm(args: &[&str], out: &Path) -> Run {
+    let mut a = vec!["export", "--material", "nylon", "--d-mm", "10"];
+    a.extend(args);
+    a.extend(["--out", out.to_str().unwrap()]);
+    run(&a)
+}
+
 /// A lossy law as a constant e: eta = 3e4 kg/(s m) on 10 mm nylon spheres gives e from 1.2e-4
 /// at 1 m/s down to 1.2e-7 (mean 1.8e-5). The export had failed with "unphysical unloading
 /// state ... p = 0.0000000000000111..." (Tsuji's inversion doubled its bracket past critical
@@ -862,44 +871,36 @@ fn a_constant_e_out_of_lammpss_reach_is_an_error_not_an_elastic_contact() {
         ),
     ] {
         let out = dir.join(rule);
-        let r = run(&[
-            "export",
-            "--engine",
-            "constant-e",
-            "--material",
-            "nylon",
-            "--d-mm",
-            "10",
-            "--eta",
-            "3e4",
-            "--v-range",
-            "1,1e3",
-            "--contact-end",
-            rule,
-            "--out",
-            out.to_str().unwrap(),
-        ]);
+        let r = export_nylon_10mm(
+            &[
+                "--engine",
+                "constant-e",
+                "--eta",
+                "3e4",
+                "--v-range",
+                "1,1e3",
+                "--contact-end",
+                rule,
+            ],
+            &out,
+        );
         assert!(!r.ok);
         assert!(r.stderr.contains(says), "{}", r.stderr);
         assert_eq!(r.stderr.lines().count(), 1, "{}", r.stderr);
         assert!(!out.exists());
     }
     let out = dir.join("tiny");
-    let r = run(&[
-        "export",
-        "--engine",
-        "constant-e",
-        "--material",
-        "nylon",
-        "--d-mm",
-        "10",
-        "--eta",
-        "1e-300",
-        "--v-range",
-        "1e-3,1e3",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let r = export_nylon_10mm(
+        &[
+            "--engine",
+            "constant-e",
+            "--eta",
+            "1e-300",
+            "--v-range",
+            "1e-3,1e3",
+        ],
+        &out,
+    );
     assert!(r.ok, "{}", r.stderr);
     let svg = read(&out, "laws.svg");
     assert!(svg.contains("η = 1e-300 kg/(s m)"), "{svg}");
@@ -914,23 +915,19 @@ fn a_constant_e_out_of_lammpss_reach_is_an_error_not_an_elastic_contact() {
 fn auto_law_passes_over_a_constant_e_lammps_cannot_give() {
     let dir = scratch("auto-reach");
     let out = dir.join("out");
-    let r = run(&[
-        "export",
-        "--engine",
-        "lammps",
-        "--material",
-        "nylon",
-        "--d-mm",
-        "10",
-        "--model",
-        "pm",
-        "--sigma-y-pa",
-        "1e3",
-        "--v-range",
-        "0.5,40",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let r = export_nylon_10mm(
+        &[
+            "--engine",
+            "lammps",
+            "--model",
+            "pm",
+            "--sigma-y-pa",
+            "1e3",
+            "--v-range",
+            "0.5,40",
+        ],
+        &out,
+    );
     assert!(r.ok, "{}", r.stderr);
     assert!(
         r.stdout.contains(

@@ -82,31 +82,30 @@ pub fn plan(
     // and collide.in's expected e says what LAMMPS gives instead. Nor for more than at cor = 0
     // (alpha = 1.2728; e = 0.114 under the overlap rule): writing cor = 1 there, as before, made
     // a lossy pair all but elastic without a word, so it is an error.
-    let lammps_cor = |inputs: &[ConstantEInputs]| -> Result<Vec<f64>, FilesFailure> {
-        inputs
-            .iter()
-            .zip(&tr.pairs)
-            .map(|(i, pair)| match i.lammps_cor {
-                Some(c) => Ok(c),
-                None if i.alpha < lammps_tsuji_alpha(0.0) => Ok(1.0),
-                None => Err(FilesFailure::OutOfReach {
-                    pair: pair.label(),
-                    engine: "LAMMPS's damping tsuji",
-                    e: i.e,
-                    e_floor: damped::restitution(lammps_tsuji_alpha(0.0), Dashpot::Tsuji, rule)
-                        .map_err(FilesFailure::ConstantE)?,
-                }),
-            })
-            .collect()
-    };
+    // Computed once: both the law's choice and the file need it.
+    let lammps_cor: Option<Result<Vec<f64>, FilesFailure>> =
+        const_inputs.as_deref().map(|inputs| {
+            inputs
+                .iter()
+                .zip(&tr.pairs)
+                .map(|(i, pair)| match i.lammps_cor {
+                    Some(c) => Ok(c),
+                    None if i.alpha < lammps_tsuji_alpha(0.0) => Ok(1.0),
+                    None => Err(FilesFailure::OutOfReach {
+                        pair: pair.label(),
+                        engine: "LAMMPS's damping tsuji",
+                        e: i.e,
+                        e_floor: damped::restitution(lammps_tsuji_alpha(0.0), Dashpot::Tsuji, rule)
+                            .map_err(FilesFailure::ConstantE)?,
+                    }),
+                })
+                .collect()
+        });
     let tsuji_law = |note: String| -> Result<LammpsLaw, FilesFailure> {
-        let inputs = const_inputs.as_ref().ok_or(FilesFailure::NeedsSpeedRange(
+        let cor = lammps_cor.clone().ok_or(FilesFailure::NeedsSpeedRange(
             "a constant e needs the scene's speeds (--v-range)",
-        ))?;
-        Ok(LammpsLaw::Tsuji {
-            cor: lammps_cor(inputs)?,
-            note,
-        })
+        ))??;
+        Ok(LammpsLaw::Tsuji { cor, note })
     };
     let vm = &tr.viscoelastic;
     let kind = tr.request.curve.kind;
@@ -122,9 +121,7 @@ pub fn plan(
                 .constant
                 .as_ref()
                 .map(|c| c.iter().map(|x| x.dev_mean).fold(0.0, f64::max));
-            let const_reachable = const_inputs
-                .as_deref()
-                .is_some_and(|i| lammps_cor(i).is_ok());
+            let const_reachable = lammps_cor.as_ref().is_some_and(|c| c.is_ok());
             let use_const = match law {
                 LawChoice::Viscoelastic => false,
                 LawChoice::ConstantE => true,
